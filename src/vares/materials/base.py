@@ -1,0 +1,207 @@
+"""Hyperelastic laws in terms of the invariants of the 2×2 right Cauchy–Green tensor.
+
+A material is a strain energy density ``Ψ`` (per unit reference volume) written as a function of
+the invariants of DESIGN.md §2,
+
+    I1 = tr C,  I3 = det C,  I4 = Φ₁·CΦ₁,  I5 = Φ₁·C²Φ₁,  I6 = Φ₂·CΦ₂,  I7 = Φ₂·C²Φ₂,  I8 = Φ₁·CΦ₂,
+
+together with its first and second derivatives with respect to the invariants it uses. Everything
+else — the second Piola–Kirchhoff stress ``S = 2 ∂Ψ/∂C`` and the tangent ``ℂ = 4 ∂²Ψ/∂C∂C`` — is
+derived here, once, for every law. A new law therefore only writes ``Ψ`` and its invariant
+derivatives; the fibre directions ``Φ₁`` (warp) and ``Φ₂`` (fill) are supplied by the caller.
+
+All functions are vectorised over leading axes and accept complex input (for complex-step checks).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+__all__ = ["INVARIANTS", "Fibres", "Hyperelastic", "MaterialError", "MaterialResponse"]
+
+#: Names of the invariants a law may use, in the order of DESIGN.md §2.
+INVARIANTS = ("I1", "I3", "I4", "I5", "I6", "I7", "I8")
+
+_EYE = np.eye(2)
+#: Symmetric fourth-order identity 𝕀_abcd = ½(δ_ac δ_bd + δ_ad δ_bc).
+_SYM_IDENTITY = 0.5 * (np.einsum("ac,bd->abcd", _EYE, _EYE) + np.einsum("ad,bc->abcd", _EYE, _EYE))
+
+
+class MaterialError(ValueError):
+    """Inadmissible material parameters or fibre directions."""
+
+
+@dataclass(frozen=True)
+class Fibres:
+    """Unit fibre directions in the pattern plane, ``(2,)`` each: ``warp`` Φ₁ and ``fill`` Φ₂."""
+
+    warp: np.ndarray
+    fill: np.ndarray
+
+    @classmethod
+    def from_angles(cls, warp_angle: float = 0.0, fill_angle: float | None = None) -> Fibres:
+        """Fibres at ``warp_angle`` and ``fill_angle`` degrees from the pattern x-axis.
+
+        The fill defaults to 90° from the warp.
+        """
+        if fill_angle is None:
+            fill_angle = warp_angle + 90.0
+        a, b = np.radians(warp_angle), np.radians(fill_angle)
+        warp = np.array([np.cos(a), np.sin(a)])
+        fill = np.array([np.cos(b), np.sin(b)])
+        if abs(warp[0] * fill[1] - warp[1] * fill[0]) < 1e-8:
+            raise MaterialError("warp and fill directions must not be parallel")
+        return cls(warp, fill)
+
+
+@dataclass(frozen=True)
+class MaterialResponse:
+    """Energy density ``psi`` ``(...)``, stress ``S`` ``(..., 2, 2)``, tangent ``(..., 2, 2, 2, 2)``.
+
+    ``tangent`` is None when it was not asked for.
+    """
+
+    psi: np.ndarray
+    stress: np.ndarray
+    tangent: np.ndarray | None
+
+
+def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return 0.5 * (np.multiply.outer(a, b) + np.multiply.outer(b, a))
+
+
+def _c_squared_hessian(phi: np.ndarray) -> np.ndarray:
+    """``∂²(Φ·C²Φ)/∂C∂C``, symmetrised over both index pairs (a constant)."""
+    # d²I[dA, dB] = Φ·(dA dB + dB dA)Φ  →  T_abcd = Φ_a δ_bc Φ_d + Φ_c δ_da Φ_b
+    t = np.einsum("a,bc,d->abcd", phi, _EYE, phi) + np.einsum("c,da,b->abcd", phi, _EYE, phi)
+    t = 0.5 * (t + t.transpose(1, 0, 2, 3))
+    return 0.5 * (t + t.transpose(0, 1, 3, 2))
+
+
+def invariants(C: np.ndarray, names: tuple[str, ...], fibres: Fibres | None):
+    """Values ``(..., k)``, first derivatives (list of ``(..., 2, 2)`` or ``(2, 2)``) and second
+    derivatives (list of ``(2, 2, 2, 2)`` constants or ``None`` where zero) of the named invariants.
+    """
+    values, first, second = [], [], []
+    tr = C[..., 0, 0] + C[..., 1, 1]
+    for name in names:
+        if name in ("I4", "I5", "I6", "I7", "I8") and fibres is None:
+            raise MaterialError(f"invariant {name} needs fibre directions (warp/fill)")
+        if name == "I1":
+            values.append(tr)
+            first.append(_EYE)
+            second.append(None)
+        elif name == "I3":
+            values.append(C[..., 0, 0] * C[..., 1, 1] - C[..., 0, 1] * C[..., 1, 0])
+            first.append(tr[..., None, None] * _EYE - C)  # cofactor of a 2×2 tensor
+            second.append(np.einsum("ab,cd->abcd", _EYE, _EYE) - _SYM_IDENTITY)
+        elif name in ("I4", "I6"):
+            phi = fibres.warp if name == "I4" else fibres.fill
+            values.append(np.einsum("a,...ab,b->...", phi, C, phi))
+            first.append(np.multiply.outer(phi, phi))
+            second.append(None)
+        elif name in ("I5", "I7"):
+            phi = fibres.warp if name == "I5" else fibres.fill
+            c_phi = np.einsum("...ab,b->...a", C, phi)
+            values.append(np.einsum("...a,...a->...", c_phi, c_phi))
+            first.append(
+                np.einsum("a,...b->...ab", phi, c_phi) + np.einsum("...a,b->...ab", c_phi, phi)
+            )
+            second.append(_c_squared_hessian(phi))
+        elif name == "I8":
+            values.append(np.einsum("a,...ab,b->...", fibres.warp, C, fibres.fill))
+            first.append(_outer(fibres.warp, fibres.fill))
+            second.append(None)
+        else:
+            raise MaterialError(f"unknown invariant {name!r}; known: {', '.join(INVARIANTS)}")
+    return np.stack(values, axis=-1), first, second
+
+
+class Hyperelastic(ABC):
+    """Base class of all laws: subclasses name their ``invariants`` and implement
+    :meth:`psi_invariants`, :meth:`dpsi_invariants` and :meth:`d2psi_invariants`.
+    """
+
+    #: The invariants ``Ψ`` depends on, a subset of :data:`INVARIANTS`.
+    invariants: ClassVar[tuple[str, ...]]
+
+    @abstractmethod
+    def psi_invariants(self, inv: np.ndarray) -> np.ndarray:
+        """``Ψ`` for invariant values ``(..., k)`` in the order of :attr:`invariants`."""
+
+    @abstractmethod
+    def dpsi_invariants(self, inv: np.ndarray) -> np.ndarray:
+        """``∂Ψ/∂I_k``, shape ``(..., k)``."""
+
+    @abstractmethod
+    def d2psi_invariants(self, inv: np.ndarray) -> np.ndarray:
+        """``∂²Ψ/∂I_k∂I_l``, shape ``(..., k, k)`` (symmetric)."""
+
+    @property
+    @abstractmethod
+    def stiffness_scale(self) -> float:
+        """A representative small-strain stiffness (stress units), used to scale tolerances."""
+
+    @property
+    def parameters(self) -> dict[str, object]:
+        """The law's parameters by name (for reports and job files)."""
+        return dict(vars(self))
+
+    @property
+    def needs_fibres(self) -> bool:
+        """True when ``Ψ`` depends on the fibre directions (an anisotropic law)."""
+        return any(name not in ("I1", "I3") for name in self.invariants)
+
+    # --------------------------------------------------------------------- derived
+    def response(
+        self, C: np.ndarray, fibres: Fibres | None = None, *, tangent: bool = True
+    ) -> MaterialResponse:
+        """Energy density, ``S = 2∂Ψ/∂C`` and optionally ``ℂ = 4∂²Ψ/∂C∂C`` at ``C`` ``(..., 2, 2)``."""
+        inv, first, second = invariants(C, self.invariants, fibres)
+        psi = self.psi_invariants(inv)
+        dpsi = self.dpsi_invariants(inv)
+        stress = sum(2.0 * dpsi[..., k, None, None] * first[k] for k in range(len(first)))
+        stress = np.broadcast_to(stress, C.shape)
+        if not tangent:
+            return MaterialResponse(psi, stress, None)
+        d2psi = self.d2psi_invariants(inv)
+        cc = np.zeros((*C.shape, 2, 2), dtype=np.result_type(C, psi))
+        for k, dk in enumerate(first):
+            for ell, dl in enumerate(first):
+                coefficient = d2psi[..., k, ell]
+                if not np.any(coefficient):
+                    continue
+                cc += (
+                    4.0
+                    * coefficient[..., None, None, None, None]
+                    * np.einsum(
+                        "...ab,...cd->...abcd",
+                        np.broadcast_to(dk, C.shape),
+                        np.broadcast_to(dl, C.shape),
+                    )
+                )
+            if second[k] is not None:
+                cc += 4.0 * dpsi[..., k, None, None, None, None] * second[k]
+        return MaterialResponse(psi, stress, cc)
+
+    def energy_density(self, C: np.ndarray, fibres: Fibres | None = None) -> np.ndarray:
+        """``Ψ(C)`` for ``C`` ``(..., 2, 2)``."""
+        inv, _, _ = invariants(C, self.invariants, fibres)
+        return self.psi_invariants(inv)
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
+        return f"{type(self).__name__}({args})"
+
+
+def check_positive(**values: float) -> None:
+    """Raise :class:`MaterialError` unless every value is a finite positive number."""
+    for name, value in values.items():
+        if not (isinstance(value, int | float | np.floating | np.integer) and np.isfinite(value)):
+            raise MaterialError(f"{name} must be a finite number; got {value!r}")
+        if value <= 0:
+            raise MaterialError(f"{name} must be positive; got {value!r}")

@@ -1,0 +1,160 @@
+"""The discrete VaReS problem: mesh, material, thickness, fibres and prestress.
+
+``Problem`` evaluates the energy of DESIGN.md eq. (1) and its exact derivatives for any pattern;
+it knows nothing about how the pattern is found (see :mod:`vares.solver`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .elements import ELEMENTS
+from .kernels import block_energy, determinant
+from .materials import Fibres, Hyperelastic, MaterialError
+from .mesh import SurfaceMesh
+
+__all__ = ["Evaluation", "Problem"]
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Energy and per-block derivatives of a pattern (blocks in ``mesh.cells`` order)."""
+
+    energy: float
+    cell_energy: list[np.ndarray]
+    gradients: list[np.ndarray] | None
+    hessians: list[np.ndarray] | None
+
+
+class Problem:
+    """Energy of erecting a pattern onto a fixed surface.
+
+    Parameters
+    ----------
+    mesh
+        The 3D surface.
+    material
+        Hyperelastic law (energy density per unit reference volume).
+    thickness
+        Membrane thickness; the energy per pattern area is ``thickness × Ψ``. For laws given as
+        force per length (``E·t``), use 1.
+    fibres
+        Warp/fill directions in the pattern plane; required for anisotropic laws.
+    prestress
+        Second Piola–Kirchhoff prestress in the pattern frame: ``(2, 2)`` uniform or
+        ``(num_cells, 2, 2)`` per cell (global cell order), stress units (× thickness = force
+        per length).
+    points
+        Surface node positions to use instead of ``mesh.points`` (pseudo-time stepping).
+    """
+
+    def __init__(
+        self,
+        mesh: SurfaceMesh,
+        material: Hyperelastic,
+        thickness: float = 1.0,
+        *,
+        fibres: Fibres | None = None,
+        prestress: np.ndarray | None = None,
+        points: np.ndarray | None = None,
+    ) -> None:
+        if not (np.isfinite(thickness) and thickness > 0):
+            raise ValueError(f"thickness must be a finite positive number; got {thickness!r}")
+        if material.needs_fibres and fibres is None:
+            raise MaterialError(f"{type(material).__name__} needs fibre directions")
+        self.mesh = mesh
+        self.material = material
+        self.thickness = float(thickness)
+        self.fibres = fibres
+        self.points = mesh.points if points is None else np.asarray(points, dtype=float)
+        self.prestress = None if prestress is None else np.asarray(prestress, dtype=float)
+        self._prestress_blocks = self._split_prestress(self.prestress)
+        self._metrics = [ELEMENTS[t].metrics(self.points, cells) for t, cells in mesh.cells.items()]
+
+    def _split_prestress(self, prestress: np.ndarray | None) -> list[np.ndarray | None]:
+        blocks = list(self.mesh.cells.values())
+        if prestress is None:
+            return [None] * len(blocks)
+        if prestress.shape == (2, 2):
+            return [prestress] * len(blocks)
+        if prestress.shape != (self.mesh.num_cells, 2, 2):
+            raise ValueError(
+                f"prestress must have shape (2, 2) or ({self.mesh.num_cells}, 2, 2); "
+                f"got {prestress.shape}"
+            )
+        out, start = [], 0
+        for cells in blocks:
+            out.append(prestress[start : start + len(cells), None])  # (m, 1, 2, 2)
+            start += len(cells)
+        return out
+
+    def with_surface(self, points: np.ndarray, prestress_factor: float = 1.0) -> Problem:
+        """The same problem on other surface positions, with the prestress scaled."""
+        prestress = None if self.prestress is None else prestress_factor * self.prestress
+        return Problem(
+            self.mesh,
+            self.material,
+            self.thickness,
+            fibres=self.fibres,
+            prestress=prestress,
+            points=points,
+        )
+
+    # ------------------------------------------------------------------ evaluation
+    def evaluate(self, coordinates: np.ndarray, order: int = 2) -> Evaluation:
+        """Energy (and per-block gradients for ``order ≥ 1``, Hessians for ``order = 2``).
+
+        ``coordinates`` is the pattern ``(n, 2)``; it must not invert any cell.
+        """
+        energies, gradients, hessians = [], [], []
+        for (cell_type, cells), metric, prestress in zip(
+            self.mesh.cells.items(), self._metrics, self._prestress_blocks, strict=True
+        ):
+            block = block_energy(
+                ELEMENTS[cell_type],
+                coordinates[cells],
+                metric,
+                self.material,
+                self.thickness,
+                fibres=self.fibres,
+                prestress=prestress,
+                order=order,
+            )
+            energies.append(block.energy)
+            gradients.append(block.gradient)
+            hessians.append(block.hessian)
+        total = float(sum(np.sum(e).real for e in energies))
+        return Evaluation(
+            total,
+            energies,
+            gradients if order >= 1 else None,
+            hessians if order >= 2 else None,
+        )
+
+    def energy(self, coordinates: np.ndarray) -> float:
+        """Energy of a pattern; ``inf`` when it inverts a cell."""
+        if self.inverted_cells(coordinates).size:
+            return float("inf")
+        return self.evaluate(coordinates, order=0).energy
+
+    def jacobian_determinants(self, coordinates: np.ndarray) -> list[np.ndarray]:
+        """``det J`` of the pattern at each block's check points, ``(m, c)`` per block."""
+        return [
+            determinant(ELEMENTS[t].jacobians(coordinates, cells, at="check"))
+            for t, cells in self.mesh.cells.items()
+        ]
+
+    def inverted_cells(self, coordinates: np.ndarray) -> np.ndarray:
+        """Global ids of the cells with ``det J ≤ 0`` somewhere (inverted or collapsed)."""
+        out, offset = [], 0
+        for det in self.jacobian_determinants(coordinates):
+            out.append(offset + np.flatnonzero(~(det > 0).all(axis=1)))
+            offset += len(det)
+        return np.concatenate(out)
+
+    @property
+    def force_scale(self) -> float:
+        """Reference force for relative residuals: stiffness × thickness × √(surface area)."""
+        return self.material.stiffness_scale * self.thickness * np.sqrt(self.mesh.area)

@@ -1,0 +1,498 @@
+"""Solution strategies: Newton–Raphson, pseudo-time stepping, damping and the automatic default.
+
+All strategies minimise the same energy (:class:`vares.problem.Problem`) over the pattern
+coordinates with the consistent tangent; they differ in the path they take:
+
+``"newton"``
+    Full Newton steps on the final surface from the initial guess.
+``"pseudo-time"``
+    The homotopy of DESIGN.md §1: the surface is raised from its projection onto the initial
+    guess plane (where the projection is the exact solution) to its true shape in ``steps``
+    equal steps, prestress ramped alike; each step is solved by Newton from the previous pattern.
+    A step that fails is halved (cut back) and retried.
+``"damping"``
+    Newton with a proximal term ``(c/2)‖X − X_k‖²`` (Levenberg–Marquardt): steps that would
+    raise the energy or invert a cell are rejected and ``c`` grows; ``c`` shrinks with the
+    residual so the final convergence stays quadratic.
+``"auto"`` (default)
+    Pseudo-time stepping that starts with a single step (plain Newton) and cuts back only where
+    needed; if even small steps fail, damped pseudo-time stepping. The history records the path.
+
+Inverted pattern cells (``det J ≤ 0``) are never accepted.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from .assembly import Assembler
+from .initial import PlaneSpec, ProjectionPlane, projection_plane
+from .linalg import LinearSolver, SingularMatrixError, get_solver
+from .materials import Fibres, Hyperelastic
+from .mesh import SurfaceMesh
+from .problem import Problem
+
+__all__ = ["STRATEGIES", "IterationRecord", "PatternResult", "StepRecord", "solve"]
+
+STRATEGIES = ("auto", "newton", "pseudo-time", "damping")
+
+
+@dataclass(frozen=True)
+class IterationRecord:
+    """State at one Newton iteration (iteration 0 is the state a step starts from)."""
+
+    strategy: str
+    step: int
+    tau: float
+    iteration: int
+    residual: float
+    relative_residual: float
+    energy: float
+    damping: float
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """Outcome of one pseudo-time step (a single step for the plain strategies)."""
+
+    strategy: str
+    step: int
+    tau: float
+    iterations: int
+    converged: bool
+    reason: str | None
+
+
+@dataclass
+class PatternResult:
+    """A cutting pattern and how it was found.
+
+    Attributes
+    ----------
+    material_coordinates
+        The pattern: 2D coordinates of every mesh node, ``(n, 2)``.
+    converged
+        True when the final residual met the tolerance on the true surface.
+    reason
+        Why the solve failed (``None`` when converged).
+    energy
+        Energy of the pattern erected onto the surface (thickness × ∫Ψ̃ dA).
+    history
+        One :class:`IterationRecord` per Newton iteration of every step tried.
+    steps
+        One :class:`StepRecord` per pseudo-time step tried, failed ones included.
+    strategy
+        The path taken, e.g. ``["pseudo-time"]`` or ``["pseudo-time", "damping"]``.
+    """
+
+    mesh: SurfaceMesh
+    material: Hyperelastic
+    thickness: float
+    material_coordinates: np.ndarray
+    converged: bool
+    reason: str | None
+    energy: float
+    history: list[IterationRecord]
+    steps: list[StepRecord]
+    strategy: list[str]
+    linear_solver: str
+    elapsed: float
+    fibres: Fibres | None = None
+    prestress: np.ndarray | None = None
+    plane: ProjectionPlane | None = None
+    _fields: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    @property
+    def iterations(self) -> int:
+        """Number of Newton iterations (linear solves) over all steps."""
+        return sum(1 for r in self.history if r.iteration > 0)
+
+    @property
+    def surface_area(self) -> float:
+        return self.mesh.area
+
+    @property
+    def pattern_area(self) -> float:
+        from .elements import ELEMENTS
+
+        return float(
+            sum(
+                ELEMENTS[t].areas(self.material_coordinates, c).sum()
+                for t, c in self.mesh.cells.items()
+            )
+        )
+
+    @property
+    def fields(self) -> dict[str, np.ndarray]:
+        """Per-cell results (global cell order); see :func:`vares.analysis.cell_fields`."""
+        if self._fields is None:
+            from .analysis import cell_fields
+
+            self._fields = cell_fields(
+                self.mesh,
+                self.material_coordinates,
+                self.material,
+                self.thickness,
+                fibres=self.fibres,
+                prestress=self.prestress,
+            )
+        return self._fields
+
+
+class _Failure(Exception):
+    def __init__(self, reason: str, coordinates: np.ndarray) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.coordinates = coordinates
+
+
+def _describe(ids: np.ndarray, limit: int = 5) -> str:
+    shown = ", ".join(str(int(i)) for i in ids[:limit])
+    return f"{ids.size} cell(s) ({shown}{', …' if ids.size > limit else ''})"
+
+
+@dataclass
+class _Context:
+    """What every step of one solve shares."""
+
+    assembler: Assembler
+    linear_solver: LinearSolver
+    residual_tolerance: float
+    energy_noise: float
+    force_scale: float
+    max_iterations: int
+    history: list[IterationRecord]
+    steps: list[StepRecord]
+    callback: Callable[[IterationRecord], None] | None
+
+
+def _newton(
+    problem: Problem,
+    coordinates: np.ndarray,
+    ctx: _Context,
+    *,
+    strategy: str,
+    step: int,
+    tau: float,
+    damping: float = 0.0,
+) -> np.ndarray:
+    """Newton–Raphson (optionally damped) on one surface; returns the converged pattern.
+
+    With ``damping > 0`` each iteration solves ``(K + c I) ΔX = −r`` and accepts the step only if
+    it lowers the energy without inverting a cell; ``c`` follows the gain ratio of actual to
+    predicted decrease (Nielsen's rule) and is capped in proportion to the residual, so it
+    vanishes as the iteration converges. Raises :class:`_Failure` when it does not converge.
+    """
+    free = ctx.assembler.free
+    x = coordinates.copy()
+    initial_residual = None
+    identity = sp.identity(ctx.assembler.num_free, format="csr")
+    c, growth = None, 2.0
+    for iteration in range(ctx.max_iterations + 1):
+        evaluation = problem.evaluate(x, order=2)
+        residual_vector = ctx.assembler.vector(evaluation.gradients).ravel()[free]
+        residual = float(np.linalg.norm(residual_vector))
+        initial_residual = residual if initial_residual is None else initial_residual
+        converged = residual <= ctx.residual_tolerance
+        matrix = None if converged else ctx.assembler.matrix(evaluation.hessians)
+        if damping > 0 and matrix is not None:
+            scale = damping * float(np.mean(np.abs(matrix.diagonal())))
+            cap = scale * min(1.0, residual / initial_residual) if initial_residual > 0 else scale
+            c = cap if c is None else min(c, cap)
+        record = IterationRecord(
+            strategy,
+            step,
+            tau,
+            iteration,
+            residual,
+            residual / ctx.force_scale,
+            evaluation.energy,
+            c or 0.0,
+        )
+        ctx.history.append(record)
+        if ctx.callback is not None:
+            ctx.callback(record)
+        if not (np.isfinite(residual) and np.isfinite(evaluation.energy)):
+            raise _Failure("non-finite energy or residual", x)
+        if converged:
+            return x
+        if iteration == ctx.max_iterations:
+            raise _Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
+        if damping == 0:
+            try:
+                ctx.linear_solver.factorize(matrix)
+                delta = ctx.linear_solver.solve(-residual_vector)
+            except SingularMatrixError as exc:
+                raise _Failure(f"singular tangent ({exc})", x) from exc
+            trial = x.copy()
+            trial.ravel()[free] += delta
+            inverted = problem.inverted_cells(trial)
+            if inverted.size:
+                raise _Failure(f"inverted elements: {_describe(inverted)}", x)
+            x = trial
+            continue
+        for _attempt in range(60):
+            try:
+                ctx.linear_solver.factorize(matrix + c * identity)
+                delta = ctx.linear_solver.solve(-residual_vector)
+            except SingularMatrixError:
+                c, growth = c * growth, 2.0 * growth
+                continue
+            trial = x.copy()
+            trial.ravel()[free] += delta
+            predicted = -(residual_vector @ delta + 0.5 * delta @ (matrix @ delta))
+            actual = evaluation.energy - problem.energy(trial)
+            if predicted > 0 and actual >= -ctx.energy_noise:
+                gain = actual / predicted
+                c *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
+                growth = 2.0
+                break
+            c, growth = c * growth, 2.0 * growth
+        else:
+            raise _Failure("damping could not find an admissible step", x)
+        x = trial
+    raise AssertionError("unreachable")
+
+
+def _run_steps(
+    base: Problem,
+    plane: ProjectionPlane,
+    start: np.ndarray,
+    taus: Sequence[float],
+    ctx: _Context,
+    *,
+    strategy: str,
+    damping: float,
+    min_step: float,
+) -> np.ndarray:
+    """Pseudo-time stepping over the planned ``taus`` with cut-back on failure."""
+    planned = [float(t) for t in taus]
+    x, tau = start, 0.0
+    step = 0
+    while planned:
+        target = planned[0]
+        step += 1
+        problem = (
+            base
+            if target == 1.0
+            else base.with_surface(plane.lift(base.points, target), prestress_factor=target)
+        )
+        before = len(ctx.history)
+        try:
+            x = _newton(problem, x, ctx, strategy=strategy, step=step, tau=target, damping=damping)
+        except _Failure as failure:
+            ctx.steps.append(
+                StepRecord(
+                    strategy, step, target, len(ctx.history) - before - 1, False, failure.reason
+                )
+            )
+            if target - tau <= min_step:
+                raise _Failure(
+                    f"{failure.reason} at τ = {target:.4g}; step size fell below {min_step:.3g}",
+                    x,
+                ) from None
+            planned.insert(0, 0.5 * (tau + target))
+            continue
+        ctx.steps.append(
+            StepRecord(strategy, step, target, len(ctx.history) - before - 1, True, None)
+        )
+        tau = planned.pop(0)
+    return x
+
+
+def _rigid_constraints(coordinates: np.ndarray, fix_rotation: bool) -> np.ndarray:
+    """Free-dof mask holding the translations (and rotation) of the pattern.
+
+    The node with the smallest pattern x is fixed; for isotropic laws the y coordinate of the
+    node with the largest x is fixed too, which removes the rotation about the first node.
+    """
+    free = np.ones(coordinates.size, dtype=bool)
+    first = int(np.argmin(coordinates[:, 0]))
+    free[2 * first : 2 * first + 2] = False
+    if fix_rotation:
+        last = int(np.argmax(coordinates[:, 0]))
+        free[2 * last + 1] = False
+    return free
+
+
+def solve(
+    mesh: SurfaceMesh,
+    material: Hyperelastic,
+    thickness: float = 1.0,
+    *,
+    strategy: str = "auto",
+    steps: int = 3,
+    initial_guess: np.ndarray | None = None,
+    plane: PlaneSpec = None,
+    tolerance: float = 1e-10,
+    max_iterations: int = 30,
+    damping: float = 1.0,
+    linear_solver: str | None = None,
+    fibres: Fibres | None = None,
+    prestress: np.ndarray | None = None,
+    callback: Callable[[IterationRecord], None] | None = None,
+) -> PatternResult:
+    """Compute the cutting pattern of ``mesh`` that minimises the erection energy.
+
+    Parameters
+    ----------
+    mesh
+        The 3D surface.
+    material, thickness
+        Hyperelastic law and membrane thickness (use 1 for laws given as force per length).
+    strategy
+        ``"auto"`` (default), ``"newton"``, ``"pseudo-time"`` or ``"damping"`` (module docs).
+    steps
+        Number of equal pseudo-time steps for ``"pseudo-time"``.
+    initial_guess
+        Pattern coordinates ``(n, 2)`` to start from instead of the projection. Pseudo-time
+        stepping needs the projection and is then not available.
+    plane
+        Plane of the projection: ``None``/``"best-fit"``, ``"xy"``, ``"yz"``, ``"zx"`` or a normal.
+    tolerance
+        Convergence when ‖residual‖ ≤ tolerance × stiffness × thickness × √area (the residual is
+        a force; this reference force makes the tolerance independent of units and mesh size).
+    max_iterations
+        Newton iterations per step.
+    damping
+        Initial damping factor of the ``"damping"`` strategy, relative to the mean tangent diagonal.
+    linear_solver
+        Name of a linear solver (:func:`vares.linalg.available_solvers`); default: the fastest.
+    fibres, prestress
+        Fibre directions (anisotropic laws) and prestress (see :class:`vares.problem.Problem`).
+    callback
+        Called with every :class:`IterationRecord` as the solve proceeds (progress display).
+
+    Returns
+    -------
+    PatternResult
+        Always returned; ``converged`` and ``reason`` tell whether and why not.
+    """
+    if strategy not in STRATEGIES:
+        raise ValueError(f"unknown strategy {strategy!r}; choose from {', '.join(STRATEGIES)}")
+    if not (isinstance(steps, int | np.integer) and steps >= 1):
+        raise ValueError(f"steps must be a positive integer; got {steps!r}")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"tolerance must be positive; got {tolerance!r}")
+    if not (isinstance(max_iterations, int | np.integer) and max_iterations >= 1):
+        raise ValueError(f"max_iterations must be a positive integer; got {max_iterations!r}")
+    if not (np.isfinite(damping) and damping > 0):
+        raise ValueError(f"damping must be positive; got {damping!r}")
+    started = time.perf_counter()
+
+    problem = Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)
+    projection = None
+    if initial_guess is None:
+        projection = projection_plane(mesh, plane)
+        start = projection.project(mesh.points)
+    else:
+        if strategy == "pseudo-time":
+            raise ValueError(
+                "pseudo-time stepping starts from the projection; "
+                "drop initial_guess or choose another strategy"
+            )
+        start = np.array(initial_guess, dtype=float)
+        if start.shape != (mesh.num_points, 2) or not np.all(np.isfinite(start)):
+            raise ValueError(
+                f"initial_guess must be finite with shape ({mesh.num_points}, 2); got {start.shape}"
+            )
+
+    free = _rigid_constraints(start, fix_rotation=not material.needs_fibres)
+    ctx = _Context(
+        assembler=Assembler(mesh, free),
+        linear_solver=get_solver(linear_solver),
+        residual_tolerance=tolerance * problem.force_scale,
+        energy_noise=1e-13 * material.stiffness_scale * problem.thickness * mesh.area,
+        force_scale=problem.force_scale,
+        max_iterations=max_iterations,
+        history=[],
+        steps=[],
+        callback=callback,
+    )
+
+    path: list[str] = []
+    reason = None
+    x = start
+    inverted = problem.inverted_cells(start)
+    if inverted.size:
+        source = "the projection onto the plane" if projection is not None else "the initial guess"
+        reason = (
+            f"{source} inverts {_describe(inverted)}; choose another plane or supply an "
+            "initial guess that does not fold"
+        )
+    else:
+        plans = _plan(strategy, steps, projection is not None)
+        for name, taus, damp in plans:
+            path.append(name)
+            try:
+                if taus is None:
+                    x = _single(problem, start, ctx, name, damping if damp else 0.0)
+                else:
+                    x = _run_steps(
+                        problem,
+                        projection,
+                        start,
+                        taus,
+                        ctx,
+                        strategy=name,
+                        damping=damping if damp else 0.0,
+                        min_step=1.0 / 1024,
+                    )
+                reason = None
+                break
+            except _Failure as failure:
+                reason = failure.reason
+                x = failure.coordinates
+    converged = reason is None
+    energy = problem.energy(x)
+    return PatternResult(
+        mesh=mesh,
+        material=material,
+        thickness=problem.thickness,
+        material_coordinates=x,
+        converged=converged,
+        reason=reason,
+        energy=energy,
+        history=ctx.history,
+        steps=ctx.steps,
+        strategy=path,
+        linear_solver=ctx.linear_solver.name,
+        elapsed=time.perf_counter() - started,
+        fibres=fibres,
+        prestress=problem.prestress,
+        plane=projection,
+    )
+
+
+def _plan(
+    strategy: str, steps: int, have_plane: bool
+) -> list[tuple[str, list[float] | None, bool]]:
+    """The sequence of attempts: (name, pseudo-time targets or None, damped)."""
+    uniform = list(np.arange(1, steps + 1) / steps)
+    if strategy == "newton":
+        return [("newton", None, False)]
+    if strategy == "damping":
+        return [("damping", None, True)]
+    if strategy == "pseudo-time":
+        return [("pseudo-time", uniform, False)]
+    if have_plane:  # auto
+        return [("pseudo-time", [1.0], False), ("damped pseudo-time", [0.25, 0.5, 0.75, 1.0], True)]
+    return [("newton", None, False), ("damping", None, True)]
+
+
+def _single(problem: Problem, start: np.ndarray, ctx: _Context, name: str, damping: float):
+    before = len(ctx.history)
+    try:
+        x = _newton(problem, start, ctx, strategy=name, step=1, tau=1.0, damping=damping)
+    except _Failure as failure:
+        ctx.steps.append(
+            StepRecord(name, 1, 1.0, len(ctx.history) - before - 1, False, failure.reason)
+        )
+        raise
+    ctx.steps.append(StepRecord(name, 1, 1.0, len(ctx.history) - before - 1, True, None))
+    return x
