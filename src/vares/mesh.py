@@ -59,9 +59,8 @@ class SurfaceMesh:
         Nodes referenced by no cell are an error by default; with ``True`` they are removed
         (with a warning) and :attr:`node_map` maps the kept nodes to the given indices.
 
-    Cells are numbered globally in the order of ``cells``: first all cells of the first type,
-    then all of the second, and so on. Error messages use this numbering, plus the number
-    within the type.
+    Error messages name cells by type and index within their block, and nodes by their index
+    in the given ``points``.
     """
 
     def __init__(
@@ -249,7 +248,8 @@ class SurfaceMesh:
             e = key[np.flatnonzero(np.isin(edge_id, over))]
             cells_at = owner[np.isin(edge_id, over)]
             raise MeshError(
-                f"non-manifold edges: edge {tuple(int(v) for v in e[0])} is shared by more "
+                f"non-manifold edges: edge {tuple(int(v) for v in self._node_map[e[0]])} is "
+                "shared by more "
                 f"than two cells ({self._describe_cells(np.unique(cells_at))})"
             )
 
@@ -326,7 +326,8 @@ class SurfaceMesh:
         bow_tie = np.flatnonzero(fans_per_node > 1)
         if bow_tie.size:
             raise MeshError(
-                f"non-manifold nodes {_listing(bow_tie)}: the cells around each of them form "
+                f"non-manifold nodes {_listing(self._node_map[bow_tie])}: the cells around "
+                "each of them form "
                 "separate fans that touch only at the node"
             )
 

@@ -60,9 +60,10 @@ class Fibres:
 
 @dataclass(frozen=True)
 class MaterialResponse:
-    """Energy density ``psi`` ``(...)``, stress ``S`` ``(..., 2, 2)``, tangent ``(..., 2, 2, 2, 2)``.
+    """A law's response at a set of states.
 
-    ``tangent`` is None when it was not asked for.
+    ``psi`` ``(...)``: energy density; ``stress`` ``(..., 2, 2)``: ``S``; ``tangent``
+    ``(..., 2, 2, 2, 2)``: ``ℂ``, or None when it was not asked for.
     """
 
     psi: np.ndarray
@@ -160,7 +161,10 @@ class Hyperelastic(ABC):
     def response(
         self, C: np.ndarray, fibres: Fibres | None = None, *, tangent: bool = True
     ) -> MaterialResponse:
-        """Energy density, ``S = 2∂Ψ/∂C`` and optionally ``ℂ = 4∂²Ψ/∂C∂C`` at ``C`` ``(..., 2, 2)``."""
+        """Energy density, ``S = 2∂Ψ/∂C`` and optionally ``ℂ = 4∂²Ψ/∂C∂C``.
+
+        ``C`` has shape ``(..., 2, 2)``.
+        """
         inv, first, second = invariants(C, self.invariants, fibres)
         psi = self.psi_invariants(inv)
         dpsi = self.dpsi_invariants(inv)

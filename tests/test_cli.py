@@ -1,0 +1,135 @@
+import json
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import vares
+from vares.cli import app
+from vares.examples import cylinder160, cylinder_arc_length, hypar
+
+runner = CliRunner()
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def error_line(result):
+    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
+def test_example_cylinder160_writes_surface_pattern_and_summary(tmp_path):
+    out = tmp_path / "cyl"
+    result = run("example", "cylinder160", "-o", out, "--cell-type", "quad")
+    assert result.exit_code == 0, result.stderr
+    assert "converged" in result.stderr and "step" in result.stderr  # progress was shown
+    surface = meshio.read(out / "surface.obj")
+    pattern = meshio.read(out / "pattern.obj")
+    np.testing.assert_array_equal(pattern.cells_dict["quad"], surface.cells_dict["quad"])
+    np.testing.assert_array_equal(pattern.points[:, 2], 0.0)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is True
+    assert summary["iterations"] > 0
+    assert summary["pattern_area"] == pytest.approx(summary["surface_area"], rel=1e-9)
+    assert abs(summary["energy"]) < 1e-9
+    width = np.ptp(pattern.points[:, 0])
+    assert width == pytest.approx(cylinder_arc_length(), rel=1e-9)
+    assert summary["fields"]["det_F"]["max"] == pytest.approx(1.0, abs=1e-8)
+    assert len(summary["history"]) == summary["iterations"] + len(summary["steps"])
+
+
+def test_pattern_command_on_a_mesh_file(tmp_path):
+    mesh = hypar(size=4.0, rise=0.15, n=8)
+    source = tmp_path / "hypar.ply"
+    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    out = tmp_path / "out"
+    result = run(
+        "pattern",
+        source,
+        "-o",
+        out,
+        "--material",
+        "st-venant-kirchhoff",
+        "--E",
+        600,
+        "--nu",
+        0.4,
+        "--thickness",
+        0.5,
+        "-q",
+    )
+    assert result.exit_code == 0, result.stderr
+    assert result.stderr == ""
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["material"] == {"law": "StVenantKirchhoff", "E": 600.0, "nu": 0.4}
+    assert summary["thickness"] == 0.5
+    expected = vares.solve(mesh, vares.materials.StVenantKirchhoff(600.0, 0.4), 0.5)
+    assert summary["energy"] == pytest.approx(expected.energy, rel=1e-9)
+    pattern = meshio.read(out / "pattern.obj")
+    assert len(pattern.points) == mesh.num_points
+
+
+def test_existing_outputs_are_not_overwritten_without_force(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text("keep me")
+    result = run("example", "cylinder160", "-o", out, "-q")
+    assert result.exit_code == 2
+    assert "output exists" in error_line(result) and "--force" in error_line(result)
+    assert (out / "summary.json").read_text() == "keep me"
+    assert not (out / "pattern.obj").exists()
+    result = run("example", "cylinder160", "-o", out, "-q", "--force")
+    assert result.exit_code == 0
+    assert json.loads((out / "summary.json").read_text())["converged"] is True
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("", "is empty"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 nan\nf 1 2 3\n", "non-finite coordinates"),
+        ("v 0 0 0\nv 1 0 0\nf 1 2 5\n", "refer to nodes outside"),
+        ("this is not a mesh\n", "contains no triangle or quad cells"),
+    ],
+)
+def test_bad_input_gives_one_line_and_exit_2(tmp_path, content, message):
+    path = tmp_path / "bad.obj"
+    path.write_text(content)
+    result = run("pattern", path, "-o", tmp_path / "out")
+    assert result.exit_code == 2
+    assert message in error_line(result)
+    assert "Traceback" not in result.stderr + result.stdout
+    assert not (tmp_path / "out").exists()
+
+
+def test_missing_file_and_bad_options(tmp_path):
+    result = run("pattern", tmp_path / "nope.obj", "-o", tmp_path / "out")
+    assert result.exit_code == 2 and "no such file" in error_line(result)
+    result = run("example", "cylinder160", "-o", tmp_path / "o", "--nu", 0.7)
+    assert result.exit_code == 2 and "Poisson" in error_line(result)
+    result = run("example", "sphere", "-o", tmp_path / "o")
+    assert result.exit_code == 2 and "unknown example" in error_line(result)
+    result = run("example", "cylinder160", "-o", tmp_path / "o", "--plane", "1,a,0")
+    assert result.exit_code == 2 and "--plane" in error_line(result)
+
+
+def test_failed_solve_exits_1_with_the_reason_and_writes_no_pattern(tmp_path):
+    out = tmp_path / "out"
+    result = run("example", "cylinder160", "-o", out, "--strategy", "newton", "-q")
+    assert result.exit_code == 1
+    assert "did not converge: inverted elements" in error_line(result)
+    assert not (out / "pattern.obj").exists()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is False and summary["reason"].startswith("inverted")
+
+
+def test_plane_normal_option(tmp_path):
+    mesh = cylinder160(n_around=12, n_along=3)
+    source = tmp_path / "c.vtu"
+    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    result = run("pattern", source, "-o", tmp_path / "out", "--plane", "0,0,1", "-q")
+    assert result.exit_code == 0, result.stderr
