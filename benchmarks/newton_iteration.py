@@ -18,7 +18,7 @@ import vares
 from vares.assembly import Assembler
 from vares.linalg import available_solvers, get_solver
 from vares.problem import Problem
-from vares.solver import _rigid_constraints
+from vares.solver import _rigid_modes
 
 
 def best_of(repeat: int, func):
@@ -45,7 +45,7 @@ def main() -> None:
     problem = Problem(mesh, material)
     x = vares.projection_plane(mesh, "xy").project(mesh.points)
 
-    setup, assembler = best_of(1, lambda: Assembler(mesh, _rigid_constraints(x, True)))
+    setup, assembler = best_of(1, lambda: Assembler(mesh, _rigid_modes(x, "fixed")[0]))
     kernel, evaluation = best_of(args.repeat, lambda: problem.evaluate(x, order=2))
     vector, residual = best_of(args.repeat, lambda: assembler.vector(evaluation.gradients))
     matrix_time, matrix = best_of(args.repeat, lambda: assembler.matrix(evaluation.hessians))

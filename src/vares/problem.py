@@ -64,6 +64,11 @@ class Problem:
             raise ValueError(f"thickness must be a finite positive number; got {thickness!r}")
         if material.needs_fibres and fibres is None:
             raise MaterialError(f"{type(material).__name__} needs fibre directions")
+        if material.requires_orthogonal_fibres and abs(fibres.warp @ fibres.fill) > 1e-9:
+            raise MaterialError(
+                f"{type(material).__name__} is written for yarns at 90° in the pattern; "
+                f"got warp and fill {np.degrees(np.arccos(fibres.warp @ fibres.fill)):.6g}° apart"
+            )
         self.mesh = mesh
         self.material = material
         self.thickness = float(thickness)

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -35,11 +35,15 @@ from .initial import PlaneSpec, ProjectionPlane, projection_plane
 from .linalg import LinearSolver, SingularMatrixError, get_solver
 from .materials import Fibres, Hyperelastic
 from .mesh import SurfaceMesh
+from .orientation import warp_deviation
 from .problem import Problem
 
 __all__ = ["STRATEGIES", "IterationRecord", "PatternResult", "StepRecord", "solve"]
 
 STRATEGIES = ("auto", "newton", "pseudo-time", "damping")
+ORIENTATIONS = ("held", "free")
+#: The mean erected warp follows a prescribed direction to this angle (radians).
+_ALIGNMENT_TOLERANCE = 1e-10
 
 
 @dataclass(frozen=True)
@@ -66,6 +70,7 @@ class StepRecord:
     iterations: int
     converged: bool
     reason: str | None
+    coordinates: np.ndarray | None = field(default=None, repr=False, compare=False)
 
 
 @dataclass
@@ -88,6 +93,11 @@ class PatternResult:
         One :class:`StepRecord` per pseudo-time step tried, failed ones included.
     strategy
         The path taken, e.g. ``["pseudo-time"]`` or ``["pseudo-time", "damping"]``.
+    fibres
+        Warp and fill directions in the pattern frame.
+    warp_direction, warp_deviation
+        The prescribed 3D warp direction (or None) and the final 3D-area-weighted mean angle
+        (degrees) between it and the erected warp.
     """
 
     mesh: SurfaceMesh
@@ -105,6 +115,9 @@ class PatternResult:
     fibres: Fibres | None = None
     prestress: np.ndarray | None = None
     plane: ProjectionPlane | None = None
+    orientation: str = "held"
+    warp_direction: np.ndarray | None = None
+    warp_deviation: float | None = None
     _fields: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     @property
@@ -169,6 +182,24 @@ class _Context:
     history: list[IterationRecord]
     steps: list[StepRecord]
     callback: Callable[[IterationRecord], None] | None
+    constraint: np.ndarray | None = None
+
+    def residual(self, gradient: np.ndarray) -> np.ndarray:
+        """The residual over the free dofs, less its component along the linear constraint."""
+        r = gradient.ravel()[self.assembler.free]
+        if self.constraint is not None:
+            r = r - self.constraint * (self.constraint @ r)
+        return r
+
+    def step(self, matrix: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+        """Solve the Newton system, bordered by the linear constraint when there is one."""
+        if self.constraint is None:
+            self.linear_solver.factorize(matrix)
+            return self.linear_solver.solve(rhs)
+        column = sp.csr_matrix(self.constraint[:, None])
+        bordered = sp.bmat([[matrix, column], [column.T, None]], format="csr")
+        self.linear_solver.factorize(bordered)
+        return self.linear_solver.solve(np.append(rhs, 0.0))[:-1]
 
 
 def _newton(
@@ -195,7 +226,7 @@ def _newton(
     c, growth = None, 2.0
     for iteration in range(ctx.max_iterations + 1):
         evaluation = problem.evaluate(x, order=2)
-        residual_vector = ctx.assembler.vector(evaluation.gradients).ravel()[free]
+        residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
         residual = float(np.linalg.norm(residual_vector))
         initial_residual = residual if initial_residual is None else initial_residual
         converged = residual <= ctx.residual_tolerance
@@ -225,8 +256,7 @@ def _newton(
             raise _Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
         if damping == 0:
             try:
-                ctx.linear_solver.factorize(matrix)
-                delta = ctx.linear_solver.solve(-residual_vector)
+                delta = ctx.step(matrix, -residual_vector)
             except SingularMatrixError as exc:
                 raise _Failure(f"singular tangent ({exc})", x) from exc
             trial = x.copy()
@@ -238,8 +268,7 @@ def _newton(
             continue
         for _attempt in range(60):
             try:
-                ctx.linear_solver.factorize(matrix + c * identity)
-                delta = ctx.linear_solver.solve(-residual_vector)
+                delta = ctx.step(matrix + c * identity, -residual_vector)
             except SingularMatrixError:
                 c, growth = c * growth, 2.0 * growth
                 continue
@@ -299,25 +328,109 @@ def _run_steps(
             planned.insert(0, 0.5 * (tau + target))
             continue
         ctx.steps.append(
-            StepRecord(strategy, step, target, len(ctx.history) - before - 1, True, None)
+            StepRecord(strategy, step, target, len(ctx.history) - before - 1, True, None, x)
         )
         tau = planned.pop(0)
     return x
 
 
-def _rigid_constraints(coordinates: np.ndarray, fix_rotation: bool) -> np.ndarray:
-    """Free-dof mask holding the translations (and rotation) of the pattern.
+def _rigid_modes(coordinates: np.ndarray, rotation: str) -> tuple[np.ndarray, np.ndarray | None]:
+    """Free-dof mask and linear rotation constraint that remove the pattern's rigid modes.
 
-    The node with the smallest pattern x is fixed; for isotropic laws the y coordinate of the
-    node with the largest x is fixed too, which removes the rotation about the first node.
+    The node with the smallest pattern x is held (translations). The rotation is
+
+    - ``"fixed"`` (isotropic laws, for which it is a zero mode): the y coordinate of the node
+      with the largest x is held too;
+    - ``"held"`` (anisotropic laws with a given orientation): the mean rotation about the held
+      node stays that of ``coordinates``, a linear constraint ``cᵀΔX = 0`` whose reaction is a
+      torque spread over the pattern like a rigid rotation, not a point force;
+    - ``"free"``: the energy chooses it.
     """
     free = np.ones(coordinates.size, dtype=bool)
     first = int(np.argmin(coordinates[:, 0]))
     free[2 * first : 2 * first + 2] = False
-    if fix_rotation:
-        last = int(np.argmax(coordinates[:, 0]))
-        free[2 * last + 1] = False
-    return free
+    if rotation == "fixed":
+        free[2 * int(np.argmax(coordinates[:, 0])) + 1] = False
+        return free, None
+    if rotation == "free":
+        return free, None
+    arm = coordinates - coordinates[first]
+    field_ = np.column_stack([-arm[:, 1], arm[:, 0]]).ravel()[free]
+    return free, field_ / np.linalg.norm(field_)
+
+
+def _align_warp(
+    make_problem: Callable[[Fibres], Problem],
+    coordinates: np.ndarray,
+    fibres: Fibres,
+    direction: np.ndarray,
+    ctx: _Context,
+    damping: float,
+) -> tuple[np.ndarray, Fibres, float]:
+    """Turn the fibres in the pattern until the mean erected warp follows ``direction``.
+
+    Secant iteration on the warp angle (the deviation changes by about the same angle as the
+    warp); each new angle is solved by Newton from the previous pattern, whose rotation stays
+    held. Returns the pattern, the fibres and the final mean deviation (radians).
+    """
+    problem = make_problem(fibres)
+    offset = _angle(fibres.fill) - _angle(fibres.warp)
+    theta = _angle(fibres.warp)
+    deviation, _ = warp_deviation(problem.mesh, coordinates, fibres.warp, direction)
+    slope = 1.0
+    for outer in range(1, 16):
+        if abs(deviation) <= _ALIGNMENT_TOLERANCE:
+            break
+        new_theta = theta - np.degrees(deviation / slope)
+        fibres = Fibres.from_angles(new_theta, new_theta + offset)
+        if problem.material.needs_fibres:
+            problem = make_problem(fibres)
+            before = len(ctx.history)
+            try:
+                coordinates = _newton(
+                    problem, coordinates, ctx, strategy="warp alignment", step=outer, tau=1.0
+                )
+            except _Failure:
+                coordinates = _newton(
+                    problem,
+                    coordinates,
+                    ctx,
+                    strategy="warp alignment",
+                    step=outer,
+                    tau=1.0,
+                    damping=damping,
+                )
+            ctx.steps.append(
+                StepRecord(
+                    "warp alignment",
+                    outer,
+                    1.0,
+                    len(ctx.history) - before - 1,
+                    True,
+                    None,
+                    coordinates,
+                )
+            )
+        new_deviation, _ = warp_deviation(problem.mesh, coordinates, fibres.warp, direction)
+        if new_theta != theta and new_deviation != deviation:
+            slope = (new_deviation - deviation) / np.radians(new_theta - theta)
+        theta, deviation = new_theta, new_deviation
+    else:
+        raise _Failure(
+            f"the warp could not be aligned with the direction (mean deviation "
+            f"{np.degrees(deviation):.3g}°)",
+            coordinates,
+        )
+    return coordinates, fibres, deviation
+
+
+def _angle(vector: np.ndarray) -> float:
+    return float(np.degrees(np.arctan2(vector[1], vector[0])))
+
+
+def _rotated(coordinates: np.ndarray, degrees: float) -> np.ndarray:
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    return coordinates @ np.array([[c, s], [-s, c]])
 
 
 def solve(
@@ -325,6 +438,11 @@ def solve(
     material: Hyperelastic,
     thickness: float = 1.0,
     *,
+    warp_angle: float = 0.0,
+    fill_angle: float | None = None,
+    warp_direction: Sequence[float] | np.ndarray | None = None,
+    orientation: str = "held",
+    prestress: np.ndarray | None = None,
     strategy: str = "auto",
     steps: int = 3,
     initial_guess: np.ndarray | None = None,
@@ -333,8 +451,6 @@ def solve(
     max_iterations: int = 30,
     damping: float = 1.0,
     linear_solver: str | None = None,
-    fibres: Fibres | None = None,
-    prestress: np.ndarray | None = None,
     callback: Callable[[IterationRecord], None] | None = None,
 ) -> PatternResult:
     """Compute the cutting pattern of ``mesh`` that minimises the erection energy.
@@ -345,6 +461,20 @@ def solve(
         The 3D surface.
     material, thickness
         Hyperelastic law and membrane thickness (use 1 for laws given as force per length).
+    warp_angle, fill_angle
+        Yarn directions in the pattern plane, degrees from the pattern x-axis (the first axis of
+        the initial-guess plane); the fill defaults to 90° from the warp.
+    warp_direction
+        A 3D direction the warp must follow on the erected surface: the fibres are turned in
+        the pattern until the 3D-area-weighted mean angle between the erected warp ``F Φ₁`` and
+        this direction (projected on the surface) is zero, and the pattern is returned with the
+        warp along +x. Overrides ``warp_angle`` (the fill keeps its angle to the warp).
+    orientation
+        For anisotropic laws without ``warp_direction``: ``"held"`` (default) keeps the
+        pattern's rotation that of the initial guess, so the yarns run at ``warp_angle`` to the
+        initial-guess plane's axes; ``"free"`` lets the energy choose the rotation.
+    prestress
+        Second Piola–Kirchhoff prestress in the pattern frame (see :class:`Problem`).
     strategy
         ``"auto"`` (default), ``"newton"``, ``"pseudo-time"`` or ``"damping"`` (module docs).
     steps
@@ -363,8 +493,6 @@ def solve(
         Initial damping factor of the ``"damping"`` strategy, relative to the mean tangent diagonal.
     linear_solver
         Name of a linear solver (:func:`vares.linalg.available_solvers`); default: the fastest.
-    fibres, prestress
-        Fibre directions (anisotropic laws) and prestress (see :class:`vares.problem.Problem`).
     callback
         Called with every :class:`IterationRecord` as the solve proceeds (progress display).
 
@@ -375,6 +503,12 @@ def solve(
     """
     if strategy not in STRATEGIES:
         raise ValueError(f"unknown strategy {strategy!r}; choose from {', '.join(STRATEGIES)}")
+    if orientation not in ORIENTATIONS:
+        raise ValueError(
+            f"unknown orientation {orientation!r}; choose from {', '.join(ORIENTATIONS)}"
+        )
+    if warp_direction is not None and orientation == "free":
+        raise ValueError("a warp direction fixes the orientation; it cannot also be free")
     if not (isinstance(steps, int | np.integer) and steps >= 1):
         raise ValueError(f"steps must be a positive integer; got {steps!r}")
     if not (np.isfinite(tolerance) and tolerance > 0):
@@ -383,9 +517,16 @@ def solve(
         raise ValueError(f"max_iterations must be a positive integer; got {max_iterations!r}")
     if not (np.isfinite(damping) and damping > 0):
         raise ValueError(f"damping must be positive; got {damping!r}")
+    for name, value in (("warp_angle", warp_angle), ("fill_angle", fill_angle)):
+        if value is not None and not np.isfinite(value):
+            raise ValueError(f"{name} must be a finite angle in degrees; got {value!r}")
     started = time.perf_counter()
+    fibres = Fibres.from_angles(warp_angle, fill_angle)
 
-    problem = Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)
+    def make_problem(fibres: Fibres) -> Problem:
+        return Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)
+
+    problem = make_problem(fibres)
     projection = None
     if initial_guess is None:
         projection = projection_plane(mesh, plane)
@@ -401,8 +542,14 @@ def solve(
             raise ValueError(
                 f"initial_guess must be finite with shape ({mesh.num_points}, 2); got {start.shape}"
             )
+    direction = None
+    if warp_direction is not None:
+        direction = np.asarray(warp_direction, dtype=float)
+        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not direction.any():
+            raise ValueError(f"warp_direction must be a non-zero 3-vector; got {warp_direction!r}")
 
-    free = _rigid_constraints(start, fix_rotation=not material.needs_fibres)
+    rotation = "fixed" if not material.needs_fibres else orientation
+    free, constraint = _rigid_modes(start, rotation)
     ctx = _Context(
         assembler=Assembler(mesh, free),
         linear_solver=get_solver(linear_solver),
@@ -413,11 +560,13 @@ def solve(
         history=[],
         steps=[],
         callback=callback,
+        constraint=constraint,
     )
 
     path: list[str] = []
     reason = None
     x = start
+    deviation = None
     inverted = problem.inverted_cells(start)
     if inverted.size:
         source = "the projection onto the plane" if projection is not None else "the initial guess"
@@ -426,8 +575,14 @@ def solve(
             "initial guess that does not fold"
         )
     else:
-        plans = _plan(strategy, steps, projection is not None)
-        for name, taus, damp in plans:
+        if direction is not None:
+            # Start with the fibres turned so that the initial guess meets the direction.
+            initial_deviation, _ = warp_deviation(mesh, start, fibres.warp, direction)
+            theta = warp_angle - np.degrees(initial_deviation)
+            offset = _angle(fibres.fill) - _angle(fibres.warp)
+            fibres = Fibres.from_angles(theta, theta + offset)
+            problem = make_problem(fibres)
+        for name, taus, damp in _plan(strategy, steps, projection is not None):
             path.append(name)
             try:
                 if taus is None:
@@ -448,6 +603,22 @@ def solve(
             except _Failure as failure:
                 reason = failure.reason
                 x = failure.coordinates
+        if reason is None and direction is not None:
+            path.append("warp alignment")
+            try:
+                x, fibres, deviation = _align_warp(make_problem, x, fibres, direction, ctx, damping)
+            except _Failure as failure:
+                reason, x = failure.reason, failure.coordinates
+            # Present the pattern with the warp along +x, as it comes off the roll.
+            turn = _angle(fibres.warp)
+            x = _rotated(x, turn)
+            for index, record in enumerate(ctx.steps):
+                if record.coordinates is not None:
+                    ctx.steps[index] = replace(
+                        record, coordinates=_rotated(record.coordinates, turn)
+                    )
+            fibres = Fibres.from_angles(0.0, _angle(fibres.fill) - turn)
+            problem = make_problem(fibres)
     converged = reason is None
     energy = problem.energy(x)
     return PatternResult(
@@ -466,6 +637,9 @@ def solve(
         fibres=fibres,
         prestress=problem.prestress,
         plane=projection,
+        orientation="direction" if direction is not None else rotation,
+        warp_direction=direction,
+        warp_deviation=None if deviation is None else float(np.degrees(deviation)),
     )
 
 
@@ -494,5 +668,5 @@ def _single(problem: Problem, start: np.ndarray, ctx: _Context, name: str, dampi
             StepRecord(name, 1, 1.0, len(ctx.history) - before - 1, False, failure.reason)
         )
         raise
-    ctx.steps.append(StepRecord(name, 1, 1.0, len(ctx.history) - before - 1, True, None))
+    ctx.steps.append(StepRecord(name, 1, 1.0, len(ctx.history) - before - 1, True, None, x))
     return x

@@ -1,5 +1,6 @@
 """Hyperelastic laws on the invariants of the in-plane right Cauchy–Green tensor."""
 
+from .anisotropic import NonCrimpFabric, OrthotropicStVenantKirchhoff
 from .base import INVARIANTS, Fibres, Hyperelastic, MaterialError, MaterialResponse
 from .isotropic import IncompressibleNeoHooke, NeoHooke, StVenantKirchhoff
 
@@ -11,5 +12,7 @@ __all__ = [
     "MaterialError",
     "MaterialResponse",
     "NeoHooke",
+    "NonCrimpFabric",
+    "OrthotropicStVenantKirchhoff",
     "StVenantKirchhoff",
 ]

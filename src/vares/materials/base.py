@@ -129,6 +129,8 @@ class Hyperelastic(ABC):
 
     #: The invariants ``Ψ`` depends on, a subset of :data:`INVARIANTS`.
     invariants: ClassVar[tuple[str, ...]]
+    #: True for laws written for yarns at 90° in the pattern (fibre-frame laws).
+    requires_orthogonal_fibres: ClassVar[bool] = False
 
     @abstractmethod
     def psi_invariants(self, inv: np.ndarray) -> np.ndarray:
