@@ -31,7 +31,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from .assembly import Assembler
+from .elements import ELEMENTS
 from .initial import PlaneSpec, ProjectionPlane, projection_plane
+from .kernels import determinant
 from .linalg import LinearSolver, SingularMatrixError, get_solver
 from .materials import Fibres, Hyperelastic
 from .mesh import SurfaceMesh
@@ -44,11 +46,18 @@ STRATEGIES = ("auto", "newton", "pseudo-time", "damping")
 ORIENTATIONS = ("held", "free")
 #: The mean erected warp follows a prescribed direction to this angle (radians).
 _ALIGNMENT_TOLERANCE = 1e-10
+#: Relative residual below which globalised Newton returns from projected to exact tangents.
+_EXACT_TANGENT_BELOW = 1e-3
 
 
 @dataclass(frozen=True)
 class IterationRecord:
-    """State at one Newton iteration (iteration 0 is the state a step starts from)."""
+    """State at one Newton iteration (iteration 0 is the state a step starts from).
+
+    ``damping`` is the damping coefficient used to reach this state, ``step_length`` the line
+    search's step length and ``tangent`` the matrix of that step (``"exact"``, ``"projected"``
+    or ``"damped"``); the last three are 0 or empty at iteration 0.
+    """
 
     strategy: str
     step: int
@@ -58,6 +67,8 @@ class IterationRecord:
     relative_residual: float
     energy: float
     damping: float
+    step_length: float = 0.0
+    tangent: str = ""
 
 
 @dataclass(frozen=True)
@@ -202,6 +213,46 @@ class _Context:
         return self.linear_solver.solve(np.append(rhs, 0.0))[:-1]
 
 
+def _step_bound(problem: Problem, x: np.ndarray, delta: np.ndarray) -> float:
+    """Largest α such that ``x + α Δ`` keeps every ``det J`` positive (``inf`` if any α does).
+
+    ``det(J + α D) = det J + α (J₀₀D₁₁ + D₀₀J₁₁ − J₀₁D₁₀ − D₀₁J₁₀) + α² det D`` at each check point.
+    """
+    bound = np.inf
+    for cell_type, cells in problem.mesh.cells.items():
+        element = ELEMENTS[cell_type]
+        J = element.jacobians(x, cells, at="check")
+        D = element.jacobians(delta, cells, at="check")
+        a = determinant(D)
+        b = J[..., 0, 0] * D[..., 1, 1] + D[..., 0, 0] * J[..., 1, 1]
+        b = b - J[..., 0, 1] * D[..., 1, 0] - D[..., 0, 1] * J[..., 1, 0]
+        c = determinant(J)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = np.sqrt(np.maximum(b * b - 4 * a * c, 0.0))
+            # the two roots, written to avoid cancellation; keep the positive ones
+            q = -0.5 * (b + np.copysign(root, b))
+            candidates = np.stack([q / a, c / q])
+        real = (b * b - 4 * a * c >= 0) | (np.abs(a) < 1e-300)
+        linear = np.where(np.abs(a) < 1e-300, -c / np.where(b == 0, np.inf, b), np.inf)
+        candidates = np.where(real, candidates, np.inf)
+        candidates = np.concatenate([candidates, linear[None]])
+        candidates = np.where((candidates > 0) & np.isfinite(candidates), candidates, np.inf)
+        bound = min(bound, float(candidates.min(initial=np.inf)))
+    return bound
+
+
+def _project_psd(hessians: list[np.ndarray]) -> list[np.ndarray]:
+    """Element Hessians with their negative eigenvalues set to zero (projected Newton)."""
+    out = []
+    for h in hessians:
+        shape = h.shape
+        k = shape[1] * shape[2]
+        values, vectors = np.linalg.eigh(h.reshape(-1, k, k))
+        projected = np.einsum("mik,mk,mjk->mij", vectors, np.maximum(values, 0.0), vectors)
+        out.append(projected.reshape(shape))
+    return out
+
+
 def _newton(
     problem: Problem,
     coordinates: np.ndarray,
@@ -210,20 +261,34 @@ def _newton(
     strategy: str,
     step: int,
     tau: float,
-    damping: float = 0.0,
+    method: str = "line-search",
+    damping: float = 1.0,
 ) -> np.ndarray:
-    """Newton–Raphson (optionally damped) on one surface; returns the converged pattern.
+    """Newton–Raphson on one surface from ``coordinates``; returns the converged pattern.
 
-    With ``damping > 0`` each iteration solves ``(K + c I) ΔX = −r`` and accepts the step only if
-    it lowers the energy without inverting a cell; ``c`` follows the gain ratio of actual to
-    predicted decrease (Nielsen's rule) and is capped in proportion to the residual, so it
-    vanishes as the iteration converges. Raises :class:`_Failure` when it does not converge.
+    ``method`` is
+
+    - ``"full"``: plain Newton, full steps; a step that inverts a cell ends it.
+    - ``"line-search"``: globalised Newton. The step is bounded so that every ``det J`` stays
+      positive and backtracked until the energy decreases enough (Armijo). Far from the
+      solution the tangent is the element-wise positive semi-definite projection of the exact
+      one (projected Newton: always a descent direction); once the relative residual is below
+      ``_EXACT_TANGENT_BELOW`` the exact tangent is used, so the final convergence is
+      quadratic, with the projection as fallback whenever the exact step is no descent.
+    - ``"damped"``: each iteration solves ``(K + c I) ΔX = −r`` and accepts the step only if it
+      lowers the energy without inverting a cell; ``c`` (starting at ``damping`` × the mean
+      tangent diagonal) follows the gain ratio of actual to predicted decrease (Nielsen's rule)
+      and is capped in proportion to the residual, so it vanishes as the iteration converges.
+
+    Raises :class:`_Failure` when it does not converge.
     """
     free = ctx.assembler.free
     x = coordinates.copy()
     initial_residual = None
     identity = sp.identity(ctx.assembler.num_free, format="csr")
     c, growth = None, 2.0
+    projected = True  # far from the solution until the residual says otherwise
+    step_length, tangent = 0.0, ""
     for iteration in range(ctx.max_iterations + 1):
         evaluation = problem.evaluate(x, order=2)
         residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
@@ -231,7 +296,7 @@ def _newton(
         initial_residual = residual if initial_residual is None else initial_residual
         converged = residual <= ctx.residual_tolerance
         matrix = None if converged else ctx.assembler.matrix(evaluation.hessians)
-        if damping > 0 and matrix is not None:
+        if method == "damped" and matrix is not None:
             scale = damping * float(np.mean(np.abs(matrix.diagonal())))
             cap = scale * min(1.0, residual / initial_residual) if initial_residual > 0 else scale
             c = cap if c is None else min(c, cap)
@@ -244,6 +309,8 @@ def _newton(
             residual / ctx.force_scale,
             evaluation.energy,
             c or 0.0,
+            step_length,
+            tangent,
         )
         ctx.history.append(record)
         if ctx.callback is not None:
@@ -254,7 +321,8 @@ def _newton(
             return x
         if iteration == ctx.max_iterations:
             raise _Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
-        if damping == 0:
+
+        if method == "full":
             try:
                 delta = ctx.step(matrix, -residual_vector)
             except SingularMatrixError as exc:
@@ -264,27 +332,64 @@ def _newton(
             inverted = problem.inverted_cells(trial)
             if inverted.size:
                 raise _Failure(f"inverted elements: {_describe(inverted)}", x)
-            x = trial
+            x, step_length, tangent = trial, 1.0, "exact"
             continue
-        for _attempt in range(60):
-            try:
-                delta = ctx.step(matrix + c * identity, -residual_vector)
-            except SingularMatrixError:
+
+        if method == "damped":
+            for _attempt in range(60):
+                try:
+                    delta = ctx.step(matrix + c * identity, -residual_vector)
+                except SingularMatrixError:
+                    c, growth = c * growth, 2.0 * growth
+                    continue
+                trial = x.copy()
+                trial.ravel()[free] += delta
+                predicted = -(residual_vector @ delta + 0.5 * delta @ (matrix @ delta))
+                actual = evaluation.energy - problem.energy(trial)
+                if predicted > 0 and actual >= -ctx.energy_noise:
+                    gain = actual / predicted
+                    c *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
+                    growth = 2.0
+                    break
                 c, growth = c * growth, 2.0 * growth
+            else:
+                raise _Failure("damping could not find an admissible step", x)
+            x, step_length, tangent = trial, 1.0, "damped"
+            continue
+
+        # globalised Newton: exact tangent first, projected where it gives no descent
+        for attempt in ("exact", "projected"):
+            if attempt == "exact" and projected:
                 continue
-            trial = x.copy()
-            trial.ravel()[free] += delta
-            predicted = -(residual_vector @ delta + 0.5 * delta @ (matrix @ delta))
-            actual = evaluation.energy - problem.energy(trial)
-            if predicted > 0 and actual >= -ctx.energy_noise:
-                gain = actual / predicted
-                c *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
-                growth = 2.0
+            if attempt == "projected":
+                projected = True
+                matrix = ctx.assembler.matrix(_project_psd(evaluation.hessians))
+            try:
+                delta = ctx.step(matrix, -residual_vector)
+            except SingularMatrixError:
+                continue
+            slope = float(residual_vector @ delta)
+            if not slope < 0:
+                continue
+            full = np.zeros_like(x)
+            full.ravel()[free] = delta
+            alpha = min(1.0, 0.9 * _step_bound(problem, x, full))
+            accepted = False
+            for _backtrack in range(40):
+                trial = x + alpha * full
+                energy = problem.energy(trial)
+                if energy <= evaluation.energy + 1e-4 * alpha * slope + ctx.energy_noise:
+                    accepted = True
+                    break
+                alpha *= 0.5
+            if accepted:
                 break
-            c, growth = c * growth, 2.0 * growth
         else:
-            raise _Failure("damping could not find an admissible step", x)
-        x = trial
+            raise _Failure("the line search found no decrease of the energy", x)
+        tangent = "projected" if projected else "exact"
+        if projected and residual < _EXACT_TANGENT_BELOW * ctx.force_scale:
+            projected = False  # near the solution: back to the exact tangent
+        x, step_length = trial, alpha
     raise AssertionError("unreachable")
 
 
@@ -296,6 +401,7 @@ def _run_steps(
     ctx: _Context,
     *,
     strategy: str,
+    method: str,
     damping: float,
     min_step: float,
 ) -> np.ndarray:
@@ -313,7 +419,16 @@ def _run_steps(
         )
         before = len(ctx.history)
         try:
-            x = _newton(problem, x, ctx, strategy=strategy, step=step, tau=target, damping=damping)
+            x = _newton(
+                problem,
+                x,
+                ctx,
+                strategy=strategy,
+                step=step,
+                tau=target,
+                method=method,
+                damping=damping,
+            )
         except _Failure as failure:
             ctx.steps.append(
                 StepRecord(
@@ -398,6 +513,7 @@ def _align_warp(
                     strategy="warp alignment",
                     step=outer,
                     tau=1.0,
+                    method="damped",
                     damping=damping,
                 )
             ctx.steps.append(
@@ -582,11 +698,11 @@ def solve(
             offset = _angle(fibres.fill) - _angle(fibres.warp)
             fibres = Fibres.from_angles(theta, theta + offset)
             problem = make_problem(fibres)
-        for name, taus, damp in _plan(strategy, steps, projection is not None):
+        for name, taus, method in _plan(strategy, steps, projection is not None):
             path.append(name)
             try:
                 if taus is None:
-                    x = _single(problem, start, ctx, name, damping if damp else 0.0)
+                    x = _single(problem, start, ctx, name, method, damping)
                 else:
                     x = _run_steps(
                         problem,
@@ -595,7 +711,8 @@ def solve(
                         taus,
                         ctx,
                         strategy=name,
-                        damping=damping if damp else 0.0,
+                        method=method,
+                        damping=damping,
                         min_step=1.0 / 1024,
                     )
                 reason = None
@@ -643,26 +760,33 @@ def solve(
     )
 
 
-def _plan(
-    strategy: str, steps: int, have_plane: bool
-) -> list[tuple[str, list[float] | None, bool]]:
-    """The sequence of attempts: (name, pseudo-time targets or None, damped)."""
+def _plan(strategy: str, steps: int, have_plane: bool) -> list[tuple[str, list[float] | None, str]]:
+    """The sequence of attempts: (name, pseudo-time targets or None, Newton method)."""
     uniform = list(np.arange(1, steps + 1) / steps)
     if strategy == "newton":
-        return [("newton", None, False)]
+        return [("newton", None, "full")]
     if strategy == "damping":
-        return [("damping", None, True)]
+        return [("damping", None, "damped")]
     if strategy == "pseudo-time":
-        return [("pseudo-time", uniform, False)]
+        return [("pseudo-time", uniform, "full")]
+    quarters = [0.25, 0.5, 0.75, 1.0]
     if have_plane:  # auto
-        return [("pseudo-time", [1.0], False), ("damped pseudo-time", [0.25, 0.5, 0.75, 1.0], True)]
-    return [("newton", None, False), ("damping", None, True)]
+        return [
+            ("globalised newton", None, "line-search"),
+            ("pseudo-time", quarters, "line-search"),
+            ("damped pseudo-time", quarters, "damped"),
+        ]
+    return [("globalised newton", None, "line-search"), ("damping", None, "damped")]
 
 
-def _single(problem: Problem, start: np.ndarray, ctx: _Context, name: str, damping: float):
+def _single(
+    problem: Problem, start: np.ndarray, ctx: _Context, name: str, method: str, damping: float
+) -> np.ndarray:
     before = len(ctx.history)
     try:
-        x = _newton(problem, start, ctx, strategy=name, step=1, tau=1.0, damping=damping)
+        x = _newton(
+            problem, start, ctx, strategy=name, step=1, tau=1.0, method=method, damping=damping
+        )
     except _Failure as failure:
         ctx.steps.append(
             StepRecord(name, 1, 1.0, len(ctx.history) - before - 1, False, failure.reason)
