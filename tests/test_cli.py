@@ -133,3 +133,134 @@ def test_plane_normal_option(tmp_path):
     meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
     result = run("pattern", source, "-o", tmp_path / "out", "--plane", "0,0,1", "-q")
     assert result.exit_code == 0, result.stderr
+
+
+def test_anisotropic_pattern_with_a_warp_direction_writes_fields(tmp_path):
+    mesh = hypar(size=4.0, rise=0.2, n=8)
+    source = tmp_path / "sail.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    out = tmp_path / "out"
+    result = run(
+        "pattern",
+        source,
+        "-o",
+        out,
+        "--material",
+        "orthotropic",
+        "--E1",
+        800,
+        "--E2",
+        640,
+        "--G12",
+        40,
+        "--nu12",
+        0.4,
+        "--warp-direction",
+        "1,1,0",
+    )
+    assert result.exit_code == 0, result.stderr
+    assert "warp_stress" in result.stderr  # the results table
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["material"] == {
+        "law": "OrthotropicStVenantKirchhoff",
+        "E1": 800.0,
+        "E2": 640.0,
+        "G12": 40.0,
+        "nu12": 0.4,
+    }
+    assert summary["fibres"]["orientation"] == "direction"
+    assert abs(summary["fibres"]["warp_deviation_degrees"]) < 1e-6
+    for name in ("warp_stretch", "shear_angle", "warp_stress", "fill_stress", "det_F"):
+        assert set(summary["fields"][name]) == {"min", "max", "mean"}
+    vtu = meshio.read(out / "pattern.vtu")
+    assert np.abs(vtu.points[:, 2]).max() == 0.0
+    expected = vares.solve(
+        mesh,
+        vares.materials.OrthotropicStVenantKirchhoff(800, 640, 40, 0.4),
+        warp_direction=(1, 1, 0),
+    )
+    np.testing.assert_allclose(
+        vtu.cell_data["shear_angle"][0], expected.fields["shear_angle"], rtol=1e-6, atol=1e-9
+    )
+    surface = meshio.read(out / "surface.vtu")
+    np.testing.assert_allclose(surface.points, mesh.points)
+    assert set(surface.cell_data) == set(vtu.cell_data)
+    assert summary["fields"]["warp_stress"]["max"] == pytest.approx(
+        expected.fields["warp_stress"].max(), rel=1e-6
+    )
+
+
+def test_ncf_and_evaluate_ply_check(tmp_path):
+    out = tmp_path / "rib"
+    result = run(
+        "example",
+        "hypar",
+        "-o",
+        out,
+        "--material",
+        "ncf",
+        "--A",
+        "-250,250",
+        "--B",
+        "-250,250",
+        "--C",
+        "2.5",
+        "--warp-angle",
+        45,
+        "-q",
+    )
+    assert result.exit_code == 0, result.stderr
+    check = tmp_path / "check"
+    result = run(
+        "evaluate",
+        out / "surface.obj",
+        out / "pattern.obj",
+        "-o",
+        check,
+        "--material",
+        "ncf",
+        "--A",
+        "-250,250",
+        "--B",
+        "-250,250",
+        "--C",
+        "2.5",
+        "--warp-angle",
+        0,
+    )
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((check / "evaluation.json").read_text())
+    assert 0 < data["compressed_area_fraction"] <= 1
+    assert len(data["compressed_cells"]) > 0
+    assert "yarns in compression" in result.stderr
+    vtu = meshio.read(check / "evaluation.vtu")
+    flags = vtu.cell_data["compressed_yarns"][0]
+    np.testing.assert_array_equal(np.flatnonzero(flags), data["compressed_cells"])
+    # a pattern that is not of this surface is refused
+    other = tmp_path / "other.obj"
+    meshio.write(other, meshio.Mesh(np.zeros((3, 3)), [("triangle", [[0, 1, 2]])]))
+    result = run(
+        "evaluate",
+        out / "surface.obj",
+        other,
+        "-o",
+        tmp_path / "x",
+        "--material",
+        "ncf",
+        "--A",
+        "-250,250",
+        "--B",
+        "-250,250",
+        "--C",
+        "2.5",
+    )
+    assert result.exit_code == 2 and "nodes and faces" in error_line(result)
+
+
+def test_material_option_errors(tmp_path):
+    result = run("example", "hypar", "-o", tmp_path / "o", "--material", "orthotropic", "--E1", 800)
+    assert result.exit_code == 2 and "orthotropic needs E2, G12, nu12" in error_line(result)
+    result = run("example", "hypar", "-o", tmp_path / "o", "--material", "ncf", "--A", "1,x")
+    assert result.exit_code == 2 and "--A" in error_line(result)
+    result = run("example", "hypar", "-o", tmp_path / "o", "--warp-direction", "1,0")
+    assert result.exit_code == 2 and "three numbers" in error_line(result)

@@ -6,11 +6,19 @@ from vares.materials import (
     IncompressibleNeoHooke,
     MaterialError,
     NeoHooke,
+    NonCrimpFabric,
+    OrthotropicStVenantKirchhoff,
     StVenantKirchhoff,
+    make_material,
 )
 from vares.materials.base import INVARIANTS, Hyperelastic
 
 LAWS = [StVenantKirchhoff(E=7.0, nu=0.3), NeoHooke(E=7.0, nu=0.3), IncompressibleNeoHooke(mu=2.0)]
+FABRICS = [
+    OrthotropicStVenantKirchhoff(E1=800.0, E2=640.0, G12=40.0, nu12=0.4),
+    NonCrimpFabric(A=[-3.0, 1.0, 2.0], B=[-2.0, 2.0], C=[0.5, 0.2, 0.1]),
+]
+FIBRES = Fibres.from_angles(25.0)
 
 
 def random_c(rng, count=5):
@@ -25,16 +33,17 @@ def sym_unit(a, b):
     return e
 
 
-@pytest.mark.parametrize("law", LAWS, ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("law", LAWS + FABRICS, ids=lambda m: type(m).__name__)
 def test_stress_and_tangent_are_derivatives_of_the_energy(law):
     """S = 2∂Ψ/∂C and ℂ = 4∂²Ψ/∂C∂C by complex step in symmetric directions."""
     rng = np.random.default_rng(1)
     C = random_c(rng)
-    response = law.response(C)
+    fibres = FIBRES if law.needs_fibres else None
+    response = law.response(C, fibres)
     h = 1e-30
     for a, b in [(0, 0), (1, 1), (0, 1)]:
         direction = sym_unit(a, b)
-        perturbed = law.response(C + 1j * h * direction)
+        perturbed = law.response(C + 1j * h * direction, fibres)
         dpsi = perturbed.psi.imag / h
         np.testing.assert_allclose(
             dpsi, 0.5 * np.einsum("nab,ab->n", response.stress, direction), rtol=1e-12
@@ -48,9 +57,10 @@ def test_stress_and_tangent_are_derivatives_of_the_energy(law):
         )
 
 
-@pytest.mark.parametrize("law", LAWS, ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("law", LAWS + FABRICS, ids=lambda m: type(m).__name__)
 def test_tangent_has_major_and_minor_symmetry(law):
-    cc = law.response(random_c(np.random.default_rng(2))).tangent
+    fibres = FIBRES if law.needs_fibres else None
+    cc = law.response(random_c(np.random.default_rng(2)), fibres).tangent
     np.testing.assert_allclose(cc, cc.transpose(0, 2, 1, 3, 4), atol=1e-12)
     np.testing.assert_allclose(cc, cc.transpose(0, 1, 2, 4, 3), atol=1e-12)
     np.testing.assert_allclose(cc, cc.transpose(0, 3, 4, 1, 2), atol=1e-12)
@@ -172,3 +182,77 @@ def test_fibre_invariants_need_fibres():
 def test_parallel_fibres_are_rejected():
     with pytest.raises(MaterialError, match="parallel"):
         Fibres.from_angles(10.0, 190.0)
+
+
+@pytest.mark.parametrize("angle", [0.0, 30.0, 72.0])
+def test_orthotropic_with_isotropic_constants_is_st_venant_kirchhoff(angle):
+    E, nu = 5.0, 0.3
+    ortho = OrthotropicStVenantKirchhoff(E1=E, E2=E, G12=E / (2 * (1 + nu)), nu12=nu)
+    iso = StVenantKirchhoff(E=E, nu=nu)
+    C = random_c(np.random.default_rng(5))
+    a, b = ortho.response(C, Fibres.from_angles(angle)), iso.response(C)
+    np.testing.assert_allclose(a.psi, b.psi, rtol=1e-12)
+    np.testing.assert_allclose(a.stress, b.stress, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(a.tangent, b.tangent, rtol=1e-12, atol=1e-12)
+
+
+def test_orthotropic_small_strain_stiffness_in_the_fibre_frame():
+    law = OrthotropicStVenantKirchhoff(E1=800.0, E2=500.0, G12=30.0, nu12=0.35)
+    fibres = Fibres.from_angles(0.0)
+    cc = law.response(np.eye(2)[None], fibres).tangent[0]
+    nu21 = 0.35 * 500 / 800
+    # uniaxial stress along the warp: strain E11 = σ/E1, E22 = −ν12 σ/E1 (compliance check)
+    Q = np.array([[cc[0, 0, 0, 0], cc[0, 0, 1, 1]], [cc[1, 1, 0, 0], cc[1, 1, 1, 1]]])
+    compliance = np.linalg.inv(Q)
+    np.testing.assert_allclose(
+        compliance, [[1 / 800, -nu21 / 500], [-0.35 / 800, 1 / 500]], rtol=1e-12
+    )
+    assert cc[0, 1, 0, 1] == pytest.approx(30.0)
+
+
+def test_non_crimp_fabric_reference_and_small_strain_moduli():
+    law = NonCrimpFabric.from_moduli(1000.0, 600.0, 4.0)
+    fibres = Fibres.from_angles(45.0)
+    response = law.response(np.eye(2)[None], fibres)
+    assert abs(response.psi[0]) < 1e-14
+    np.testing.assert_allclose(response.stress[0], 0.0, atol=1e-13)
+    cc = np.einsum("abcd,a,b,c,d->", response.tangent[0], *[fibres.warp] * 4)
+    assert cc == pytest.approx(1000.0)
+    assert np.einsum("abcd,a,b,c,d->", response.tangent[0], *[fibres.fill] * 4) == pytest.approx(
+        600.0
+    )
+    shear = np.einsum(
+        "abcd,a,b,c,d->", response.tangent[0], fibres.warp, fibres.fill, fibres.warp, fibres.fill
+    )
+    assert shear == pytest.approx(4.0)
+    assert law.warp_modulus == pytest.approx(1000.0) and law.fill_modulus == pytest.approx(600.0)
+
+
+def test_non_crimp_fabric_shear_energy_is_the_cos_squared_series():
+    law = NonCrimpFabric(A=[-1.0, 1.0], B=[-1.0, 1.0], C=[2.0, 3.0])
+    fibres = Fibres.from_angles(0.0)
+    shear = np.radians(20.0)  # pure shear of the yarns, unit stretches
+    C = np.array([[1.0, np.sin(shear)], [np.sin(shear), 1.0]])
+    cos2 = np.sin(shear) ** 2  # angle between yarns is 90° − 20°
+    assert law.energy_density(C, fibres) == pytest.approx(2.0 * cos2 + 3.0 / 2 * cos2**2)
+
+
+@pytest.mark.parametrize(
+    ("factory", "message"),
+    [
+        (lambda: OrthotropicStVenantKirchhoff(800, 100, 30, 3.0), "not positive definite"),
+        (lambda: OrthotropicStVenantKirchhoff(800, -1, 30, 0.3), "E2 must be positive"),
+        (lambda: OrthotropicStVenantKirchhoff(800, 100, 0, 0.3), "G12 must be positive"),
+        (lambda: NonCrimpFabric([1.0, 1.0], [-1.0, 1.0], [1.0]), r"sum\(A\) must be 0"),
+        (lambda: NonCrimpFabric([-1.0, 1.0], [1.0, -1.0], [1.0]), "moduli"),
+        (lambda: NonCrimpFabric([-1.0, 1.0], [-1.0, 1.0], [-1.0]), r"C\[0\] must be positive"),
+        (lambda: NonCrimpFabric([-1.0, 1.0], [-1.0, 1.0], []), "at least one"),
+        (lambda: NonCrimpFabric([-1.0, np.nan], [-1.0, 1.0], [1.0]), "finite"),
+        (lambda: make_material("kevlar", {}), "unknown material"),
+        (lambda: make_material("orthotropic", {"E1": 1.0}), "needs E2, G12, nu12"),
+        (lambda: make_material("neo-hooke", {"E": 1.0, "nu": 0.3, "mu": 2.0}), "mu"),
+    ],
+)
+def test_fabric_parameters_are_validated(factory, message):
+    with pytest.raises(MaterialError, match=message):
+        factory()

@@ -14,6 +14,7 @@ from .elements import ELEMENTS
 from .kernels import determinant, inverse
 from .materials import Fibres, Hyperelastic
 from .mesh import SurfaceMesh
+from .orientation import warp_deviation
 from .problem import Problem
 
 __all__ = ["FIELD_DESCRIPTIONS", "PatternEvaluation", "cell_fields", "evaluate"]
@@ -25,11 +26,24 @@ FIELD_DESCRIPTIONS: dict[str, tuple[str, str]] = {
     "stretch_min": ("smaller principal stretch", "1"),
     "stress_max": ("larger principal Cauchy stress", "stress"),
     "stress_min": ("smaller principal Cauchy stress", "stress"),
+    "warp_stretch": ("stretch along the warp, √I4", "1"),
+    "fill_stretch": ("stretch along the fill, √I6", "1"),
+    "shear_angle": ("yarn shear angle: decrease of the angle between the yarns", "degree"),
+    "warp_stress": ("Cauchy stress along the erected warp", "stress"),
+    "fill_stress": ("Cauchy stress along the erected fill", "stress"),
+    "warp_stress_pk2": ("2nd Piola–Kirchhoff stress Φ₁·SΦ₁ along the warp", "stress"),
+    "fill_stress_pk2": ("2nd Piola–Kirchhoff stress Φ₂·SΦ₂ along the fill", "stress"),
+    "compressed_yarns": ("1 where the warp or the fill is in compression", "1"),
+    "wrinkling": ("1 where a principal stress is compressive (wrinkling risk)", "1"),
     "energy": ("strain energy of the cell (thickness × ∫Ψ̃ dA)", "energy"),
     "energy_density": ("strain energy density Ψ per reference volume", "stress"),
     "pattern_area": ("area of the cell in the pattern", "area"),
     "surface_area": ("area of the cell on the 3D surface", "area"),
+    "warp_deviation": ("angle from the prescribed 3D warp direction to the erected warp", "degree"),
 }
+
+#: Compressive stresses below this fraction of the material's stiffness are round-off.
+COMPRESSION_TOLERANCE = 1e-8
 
 
 def _symmetric_eigenvalues(trace: np.ndarray, det: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -47,12 +61,21 @@ def cell_fields(
     *,
     fibres: Fibres | None = None,
     prestress: np.ndarray | None = None,
+    warp_direction: np.ndarray | None = None,
+    compression_threshold: float = 0.0,
 ) -> dict[str, np.ndarray]:
     """Per-cell fields of a pattern ``(n, 2)`` erected onto ``mesh`` (global cell order).
 
     See :data:`FIELD_DESCRIPTIONS` for the names. Stresses are Cauchy stresses of the
-    material (the prestress is the target, not part of the stress).
+    material (the prestress is the target, not part of the stress). Yarn fields need
+    ``fibres`` (default: warp along x, fill along y); ``warp_deviation`` needs
+    ``warp_direction``. A yarn or principal stress counts as compressive below
+    ``−compression_threshold`` (stress units; round-off is never counted).
     """
+    if fibres is None:
+        fibres = Fibres.from_angles(0.0)
+    compressive = -max(compression_threshold, COMPRESSION_TOLERANCE * material.stiffness_scale)
+    reference_angle = np.degrees(np.arccos(np.clip(fibres.warp @ fibres.fill, -1.0, 1.0)))
     problem = Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)
     cell_energy = problem.evaluate(coordinates, order=0).cell_energy
     per_block: dict[str, list[np.ndarray]] = {name: [] for name in FIELD_DESCRIPTIONS}
@@ -80,20 +103,61 @@ def cell_fields(
         per_block["stretch_min"].append(mean(np.sqrt(np.maximum(stretch_sq[1], 0.0))))
         per_block["stress_max"].append(mean(stress[0] / det_f))
         per_block["stress_min"].append(mean(stress[1] / det_f))
+        i4 = np.einsum("a,mqab,b->mq", fibres.warp, C, fibres.warp)
+        i6 = np.einsum("a,mqab,b->mq", fibres.fill, C, fibres.fill)
+        i8 = np.einsum("a,mqab,b->mq", fibres.warp, C, fibres.fill)
+        yarn_angle = np.degrees(np.arccos(np.clip(i8 / np.sqrt(i4 * i6), -1.0, 1.0)))
+        CSC = C @ response.stress @ C
+        warp_cauchy = mean(np.einsum("a,mqab,b->mq", fibres.warp, CSC, fibres.warp) / (i4 * det_f))
+        fill_cauchy = mean(np.einsum("a,mqab,b->mq", fibres.fill, CSC, fibres.fill) / (i6 * det_f))
+        per_block["warp_stretch"].append(mean(np.sqrt(i4)))
+        per_block["fill_stretch"].append(mean(np.sqrt(i6)))
+        per_block["shear_angle"].append(mean(reference_angle - yarn_angle))
+        per_block["warp_stress"].append(warp_cauchy)
+        per_block["fill_stress"].append(fill_cauchy)
+        per_block["warp_stress_pk2"].append(
+            mean(np.einsum("a,mqab,b->mq", fibres.warp, response.stress, fibres.warp))
+        )
+        per_block["fill_stress_pk2"].append(
+            mean(np.einsum("a,mqab,b->mq", fibres.fill, response.stress, fibres.fill))
+        )
+        per_block["compressed_yarns"].append(
+            ((warp_cauchy < compressive) | (fill_cauchy < compressive)).astype(float)
+        )
+        per_block["wrinkling"].append((per_block["stress_min"][-1] < compressive).astype(float))
         per_block["energy"].append(energy)
         per_block["energy_density"].append(mean(response.psi))
         per_block["pattern_area"].append(area)
         per_block["surface_area"].append(element.areas(mesh.points, cells))
+    if warp_direction is not None:
+        _, deviation = warp_deviation(mesh, coordinates, fibres.warp, warp_direction)
+        per_block["warp_deviation"] = [np.degrees(deviation)]
+    else:
+        del per_block["warp_deviation"]
     return {name: np.concatenate(values) for name, values in per_block.items()}
 
 
 @dataclass(frozen=True)
 class PatternEvaluation:
-    """Energy and per-cell fields of a given pattern."""
+    """Energy and per-cell fields of a given pattern erected onto a surface.
+
+    ``compressed_cells``: cells whose warp or fill is in compression (where a ply cut from this
+    pattern would wrinkle); ``compressed_area_fraction``: their share of the 3D area.
+    """
 
     energy: float
     fields: dict[str, np.ndarray]
     inverted_cells: np.ndarray
+    fibres: Fibres
+
+    @property
+    def compressed_cells(self) -> np.ndarray:
+        return np.flatnonzero(self.fields["compressed_yarns"] > 0)
+
+    @property
+    def compressed_area_fraction(self) -> float:
+        area = self.fields["surface_area"]
+        return float(area[self.compressed_cells].sum() / area.sum())
 
 
 def evaluate(
@@ -102,20 +166,37 @@ def evaluate(
     material: Hyperelastic,
     thickness: float = 1.0,
     *,
-    fibres: Fibres | None = None,
+    warp_angle: float = 0.0,
+    fill_angle: float | None = None,
     prestress: np.ndarray | None = None,
+    warp_direction: np.ndarray | None = None,
+    compression_threshold: float = 0.0,
 ) -> PatternEvaluation:
-    """Evaluate any pattern ``(n, 2)`` (optimised or not) with a material and fibre directions."""
+    """Evaluate any pattern ``(n, 2)`` (optimised or not) with a material and yarn directions.
+
+    ``warp_angle``/``fill_angle`` are degrees in the pattern frame, so a pattern optimised for
+    one ply can be checked for another (the ply-stack check): e.g. a pattern made with
+    ``warp_angle=45, fill_angle=-45`` evaluated with ``warp_angle=0``. Yarn stresses below
+    ``−compression_threshold`` count as compressed (see :func:`cell_fields`).
+    """
     coordinates = np.asarray(coordinates, dtype=float)
     if coordinates.shape != (mesh.num_points, 2):
         raise ValueError(
             f"coordinates must have shape ({mesh.num_points}, 2); got {coordinates.shape}"
         )
+    fibres = Fibres.from_angles(warp_angle, fill_angle)
     problem = Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)
     inverted = problem.inverted_cells(coordinates)
     energy = problem.energy(coordinates)
     with np.errstate(invalid="ignore", divide="ignore"):
         fields = cell_fields(
-            mesh, coordinates, material, thickness, fibres=fibres, prestress=prestress
+            mesh,
+            coordinates,
+            material,
+            thickness,
+            fibres=fibres,
+            prestress=prestress,
+            warp_direction=warp_direction,
+            compression_threshold=compression_threshold,
         )
-    return PatternEvaluation(energy, fields, inverted)
+    return PatternEvaluation(energy, fields, inverted, fibres)

@@ -7,6 +7,11 @@
 ``hypar``
     A hyperbolic paraboloid ``z = c x y`` over a square: doubly curved (anticlastic), the shape
     of a four-point sail.
+``rib30``
+    A generic 30° segment of a curved composite rib (seed §5.2): a hat-shaped cross-section
+    (web, inclined walls, flanges, rounded corners) swept along a circular arc. The rounded
+    corners become toroidal, doubly curved patches; the pattern of a fabric ply must stretch and
+    shear there.
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ import numpy as np
 
 from .mesh import SurfaceMesh
 
-__all__ = ["EXAMPLES", "cylinder160", "cylinder_arc_length", "grid_cells", "hypar"]
+__all__ = ["EXAMPLES", "cylinder160", "cylinder_arc_length", "grid_cells", "hypar", "rib30"]
 
 
 def grid_cells(n_u: int, n_v: int, cell_type: str = "triangle") -> dict[str, np.ndarray]:
@@ -87,5 +92,93 @@ def hypar(
     return SurfaceMesh(points, grid_cells(n + 1, n + 1, cell_type))
 
 
+def _filleted_profile(corners: np.ndarray, fillet: float, spacing: float, fillet_segments: int):
+    """Sample a polyline whose interior corners are rounded with arcs of radius ``fillet``.
+
+    Returns the points ``(k, 2)`` of the profile in order.
+    """
+    pieces: list[np.ndarray] = []
+    start = corners[0]
+    for b in range(1, len(corners) - 1):
+        a, corner, c = corners[b - 1], corners[b], corners[b + 1]
+        t1 = (corner - a) / np.linalg.norm(corner - a)
+        t2 = (c - corner) / np.linalg.norm(c - corner)
+        turn = np.arctan2(t1[0] * t2[1] - t1[1] * t2[0], t1 @ t2)
+        tangent = fillet * np.tan(abs(turn) / 2)
+        if tangent >= min(np.linalg.norm(corner - a), np.linalg.norm(c - corner)) / 2:
+            raise ValueError("the fillet radius is too large for the profile")
+        enter, leave = corner - tangent * t1, corner + tangent * t2
+        pieces.append(_segment(start, enter, spacing)[:-1])
+        side = np.sign(turn)
+        centre = enter + fillet * side * np.array([-t1[1], t1[0]])
+        phi0 = np.arctan2(*(enter - centre)[::-1])
+        phis = phi0 + np.linspace(0.0, turn, fillet_segments + 1)
+        pieces.append((centre + fillet * np.column_stack([np.cos(phis), np.sin(phis)]))[:-1])
+        start = leave
+    pieces.append(_segment(start, corners[-1], spacing))
+    return np.vstack(pieces)
+
+
+def _segment(a: np.ndarray, b: np.ndarray, spacing: float) -> np.ndarray:
+    count = max(1, int(np.ceil(np.linalg.norm(b - a) / spacing)))
+    return a + np.linspace(0.0, 1.0, count + 1)[:, None] * (b - a)
+
+
+def rib30(
+    radius: float = 1.0,
+    angle: float = 30.0,
+    width: float = 0.12,
+    height: float = 0.05,
+    flange: float = 0.04,
+    wall_angle: float = 60.0,
+    fillet: float = 0.015,
+    spacing: float = 0.01,
+    fillet_segments: int = 6,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """A hat-section rib segment swept by ``angle`` degrees about the z-axis.
+
+    The cross-section (in the radial–vertical plane, centred on ``radius``) is a web of
+    ``width`` at z = ``height``, two walls inclined at ``wall_angle`` degrees to the horizontal
+    down to z = 0 and two flanges of ``flange`` outwards, every corner rounded with radius
+    ``fillet``. The segment spans ``±angle/2`` about the x-axis, so the rib runs along +y at its
+    middle. Units are the caller's (metres by default). ``spacing`` is the target cell size.
+    """
+    if not 0 < angle < 180:
+        raise ValueError(f"angle must lie in (0, 180) degrees; got {angle}")
+    if not 0 < wall_angle < 90:
+        raise ValueError(f"wall_angle must lie in (0, 90) degrees; got {wall_angle}")
+    run = height / np.tan(np.radians(wall_angle))
+    half, bottom = width / 2, width / 2 + run
+    corners = np.array(
+        [
+            [-bottom - flange, 0.0],
+            [-bottom, 0.0],
+            [-half, height],
+            [half, height],
+            [bottom, 0.0],
+            [bottom + flange, 0.0],
+        ]
+    )
+    profile = _filleted_profile(corners, fillet, spacing, fillet_segments)
+    arc = np.radians(angle) * radius
+    phi = np.radians(np.linspace(-angle / 2, angle / 2, max(2, int(np.ceil(arc / spacing))) + 1))
+    r = radius + profile[:, 0]
+    points = np.column_stack(
+        [
+            np.outer(np.cos(phi), r).ravel(),
+            np.outer(np.sin(phi), r).ravel(),
+            np.tile(profile[:, 1], len(phi)),
+        ]
+    )
+    return SurfaceMesh(points, grid_cells(len(profile), len(phi), cell_type))
+
+
 #: Example generators by name (used by ``vares example``).
-EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {"cylinder160": cylinder160, "hypar": hypar}
+EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {
+    "cylinder160": cylinder160,
+    "hypar": hypar,
+    "rib30": rib30,
+}
+#: The initial-guess plane each example is meant to be patterned with.
+EXAMPLE_PLANES = {"cylinder160": "xy"}

@@ -7,6 +7,7 @@ caller allows it.
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import tempfile
@@ -23,6 +24,8 @@ __all__ = [
     "OutputExistsError",
     "atomic_path",
     "check_writable",
+    "field_statistics",
+    "read_pattern",
     "summary",
     "write_json",
     "write_surface",
@@ -69,19 +72,61 @@ def _write_with(path: Path, writer: Callable[[Path], None]) -> None:
         writer(temporary)
 
 
-def write_surface(path: Path, mesh: SurfaceMesh, coordinates: np.ndarray | None = None) -> None:
+def write_surface(
+    path: Path,
+    mesh: SurfaceMesh,
+    coordinates: np.ndarray | None = None,
+    fields: dict[str, np.ndarray] | None = None,
+) -> None:
     """Write the mesh (or, with ``coordinates`` ``(n, 2)``, the flat pattern at z = 0).
 
     The format follows the suffix (any format meshio writes: .obj, .vtu, .ply, .stl, …); nodes
-    and cells are those of ``mesh``, in the same order.
+    and cells are those of ``mesh``, in the same order. ``fields`` (per cell, global cell order)
+    are written as cell data where the format has it (VTU, VTK).
     """
     import meshio
 
     points = mesh.points
     if coordinates is not None:
         points = np.column_stack([coordinates, np.zeros(len(coordinates))])
-    out = meshio.Mesh(points, [(t, c) for t, c in mesh.cells.items()])
+    blocks = list(mesh.cells.items())
+    cell_data = {}
+    if fields:
+        bounds = np.cumsum([0] + [len(c) for _, c in blocks])
+        cell_data = {
+            name: [np.asarray(values[a:b], dtype=float) for a, b in itertools.pairwise(bounds)]
+            for name, values in fields.items()
+        }
+    out = meshio.Mesh(points, blocks, cell_data=cell_data)
     _write_with(Path(path), lambda p: meshio.write(p, out, file_format=_meshio_format(path)))
+
+
+def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
+    """Pattern coordinates ``(n, 2)`` from a file written by :func:`write_surface` for ``mesh``.
+
+    The file must have the same cells as ``mesh`` (same nodes and faces) and lie in z = 0.
+    """
+    import meshio
+
+    from .mesh import MeshError
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path}")
+    try:
+        raw = meshio.read(path)
+    except Exception as exc:
+        raise MeshError(f"cannot read {path}: {type(exc).__name__}: {exc}") from exc
+    cells = {b.type: b.data for b in raw.cells if b.type in mesh.cells}
+    same = len(raw.points) == mesh.num_points and all(
+        t in cells and np.array_equal(cells[t], c) for t, c in mesh.cells.items()
+    )
+    if not same:
+        raise MeshError(f"{path} does not have the nodes and faces of the surface mesh")
+    points = np.asarray(raw.points, dtype=float)
+    if points.shape[1] == 3 and np.abs(points[:, 2]).max(initial=0.0) > 1e-9 * np.ptp(points):
+        raise MeshError(f"{path} is not flat (z ≠ 0): not a pattern")
+    return points[:, :2].copy()
 
 
 def _meshio_format(path: Path) -> str | None:
@@ -109,6 +154,19 @@ def _statistics(values: np.ndarray, weights: np.ndarray) -> dict[str, float]:
         return {"min": float("nan"), "max": float("nan"), "mean": float("nan")}
     v, w = values[finite], weights[finite]
     return {"min": float(v.min()), "max": float(v.max()), "mean": float(v @ w / w.sum())}
+
+
+def field_statistics(fields: dict[str, np.ndarray]) -> dict[str, dict[str, float]]:
+    """Min, max and pattern-area-weighted mean of every per-cell field (areas excluded).
+
+    For the 0/1 flags (``compressed_yarns``, ``wrinkling``) the mean is the area fraction.
+    """
+    weights = fields["pattern_area"]
+    return {
+        name: _statistics(values, weights)
+        for name, values in fields.items()
+        if name not in ("pattern_area", "surface_area", "energy")
+    }
 
 
 def summary(result: PatternResult, **extra: object) -> dict:
@@ -151,14 +209,15 @@ def summary(result: PatternResult, **extra: object) -> dict:
             for s in result.steps
         ],
     }
+    out["fibres"] = {
+        "orientation": result.orientation,
+        "warp": result.fibres.warp,
+        "fill": result.fibres.fill,
+        "warp_direction": result.warp_direction,
+        "warp_deviation_degrees": result.warp_deviation,
+    }
     if result.converged:
-        fields = result.fields
-        weights = fields["pattern_area"]
-        out["fields"] = {
-            name: _statistics(values, weights)
-            for name, values in fields.items()
-            if name not in ("pattern_area", "surface_area", "energy")
-        }
+        out["fields"] = field_statistics(result.fields)
     out["history"] = [
         {
             "strategy": r.strategy,

@@ -164,6 +164,7 @@ class PatternResult:
                 self.thickness,
                 fibres=self.fibres,
                 prestress=self.prestress,
+                warp_direction=self.warp_direction,
             )
         return self._fields
 
@@ -456,9 +457,11 @@ def _rigid_modes(coordinates: np.ndarray, rotation: str) -> tuple[np.ndarray, np
 
     - ``"fixed"`` (isotropic laws, for which it is a zero mode): the y coordinate of the node
       with the largest x is held too;
-    - ``"held"`` (anisotropic laws with a given orientation): the mean rotation about the held
-      node stays that of ``coordinates``, a linear constraint ``cᵀΔX = 0`` whose reaction is a
-      torque spread over the pattern like a rigid rotation, not a point force;
+    - ``"held"`` (anisotropic laws with a given orientation): the mean rotation about the
+      centroid stays that of ``coordinates``, a linear constraint ``cᵀΔX = 0`` (``c`` the rigid
+      rotation field, blind to translations, so the choice of the held node does not matter)
+      whose reaction is a torque spread over the pattern like a rigid rotation, not a point
+      force;
     - ``"free"``: the energy chooses it.
     """
     free = np.ones(coordinates.size, dtype=bool)
@@ -469,7 +472,7 @@ def _rigid_modes(coordinates: np.ndarray, rotation: str) -> tuple[np.ndarray, np
         return free, None
     if rotation == "free":
         return free, None
-    arm = coordinates - coordinates[first]
+    arm = coordinates - coordinates.mean(axis=0)
     field_ = np.column_stack([-arm[:, 1], arm[:, 0]]).ravel()[free]
     return free, field_ / np.linalg.norm(field_)
 
@@ -545,6 +548,7 @@ def _angle(vector: np.ndarray) -> float:
 
 
 def _rotated(coordinates: np.ndarray, degrees: float) -> np.ndarray:
+    """Points ``(n, 2)`` turned counter-clockwise by ``degrees`` about the origin."""
     c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
     return coordinates @ np.array([[c, s], [-s, c]])
 
@@ -564,7 +568,7 @@ def solve(
     initial_guess: np.ndarray | None = None,
     plane: PlaneSpec = None,
     tolerance: float = 1e-10,
-    max_iterations: int = 30,
+    max_iterations: int = 50,
     damping: float = 1.0,
     linear_solver: str | None = None,
     callback: Callable[[IterationRecord], None] | None = None,
@@ -728,11 +732,11 @@ def solve(
                 reason, x = failure.reason, failure.coordinates
             # Present the pattern with the warp along +x, as it comes off the roll.
             turn = _angle(fibres.warp)
-            x = _rotated(x, turn)
+            x = _rotated(x, -turn)
             for index, record in enumerate(ctx.steps):
                 if record.coordinates is not None:
                     ctx.steps[index] = replace(
-                        record, coordinates=_rotated(record.coordinates, turn)
+                        record, coordinates=_rotated(record.coordinates, -turn)
                     )
             fibres = Fibres.from_angles(0.0, _angle(fibres.fill) - turn)
             problem = make_problem(fibres)

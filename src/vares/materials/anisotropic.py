@@ -22,8 +22,9 @@ class OrthotropicStVenantKirchhoff(Hyperelastic):
     ``Ψ = ½ (Q11 E11² + 2 Q12 E11 E22 + Q22 E22² + Q66 γ²)`` with ``E11 = (I4 − 1)/2``,
     ``E22 = (I6 − 1)/2``, the engineering shear strain ``γ = 2 E12 = I8`` and the plane-stress
     stiffnesses ``Q11 = E1/(1 − ν12 ν21)``, ``Q22 = E2/(1 − ν12 ν21)``,
-    ``Q12 = ν12 E2/(1 − ν12 ν21)``, ``Q66 = G12``, ``ν21 = ν12 E2/E1``. For fabrics given as force per length (``E·t``) use
-    thickness 1. With ``E1 = E2 = E`` and ``G12 = E/(2(1 + ν))`` it is the isotropic law.
+    ``Q12 = ν12 E2/(1 − ν12 ν21)``, ``Q66 = G12``, ``ν21 = ν12 E2/E1``. For fabrics given as
+    force per length (``E·t``) use thickness 1. With ``E1 = E2 = E`` and
+    ``G12 = E/(2(1 + ν))`` it is the isotropic law.
     """
 
     invariants = ("I4", "I6", "I8")

@@ -1,0 +1,143 @@
+"""Pictures of patterns and surfaces (matplotlib, no screen needed).
+
+Every function draws on an ``Axes`` it is given or creates, and returns the figure, so callers
+decide where it goes (``fig.savefig("pattern.png")``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import PolyCollection
+from matplotlib.colors import Normalize, TwoSlopeNorm
+
+from .materials import Fibres
+from .mesh import SurfaceMesh
+
+__all__ = ["FIELD_LABELS", "plot_pattern", "save_pattern_figure"]
+
+#: Short colour bar labels of the per-cell fields; ``{stress}`` is replaced by the stress unit.
+FIELD_LABELS = {
+    "det_F": "det F (area erected / pattern) [-]",
+    "stretch_max": "larger principal stretch [-]",
+    "stretch_min": "smaller principal stretch [-]",
+    "stress_max": "larger principal stress [{stress}]",
+    "stress_min": "smaller principal stress [{stress}]",
+    "warp_stretch": "warp stretch [-]",
+    "fill_stretch": "fill stretch [-]",
+    "shear_angle": "yarn shear angle [°]",
+    "warp_stress": "warp stress (Cauchy) [{stress}]",
+    "fill_stress": "fill stress (Cauchy) [{stress}]",
+    "warp_stress_pk2": "warp stress (2nd P-K) [{stress}]",
+    "fill_stress_pk2": "fill stress (2nd P-K) [{stress}]",
+    "compressed_yarns": "compressed yarns (1 = yes)",
+    "wrinkling": "compressive principal stress (1 = yes)",
+    "energy": "strain energy",
+    "energy_density": "strain energy density [{stress}]",
+    "pattern_area": "pattern area",
+    "surface_area": "surface area",
+    "warp_deviation": "warp deviation from the direction [°]",
+}
+#: Fields whose colour scale is centred on a neutral value (diverging colours).
+_CENTRED = {
+    "det_F": 1.0,
+    "warp_stretch": 1.0,
+    "fill_stretch": 1.0,
+    "stretch_max": 1.0,
+    "stretch_min": 1.0,
+    "shear_angle": 0.0,
+    "warp_stress": 0.0,
+    "fill_stress": 0.0,
+    "warp_stress_pk2": 0.0,
+    "fill_stress_pk2": 0.0,
+    "stress_max": 0.0,
+    "stress_min": 0.0,
+    "warp_deviation": 0.0,
+}
+
+
+def _polygons(mesh: SurfaceMesh, coordinates: np.ndarray) -> list[np.ndarray]:
+    return [coordinates[cell] for cells in mesh.cells.values() for cell in cells]
+
+
+def plot_pattern(
+    mesh: SurfaceMesh,
+    coordinates: np.ndarray,
+    values: np.ndarray | None = None,
+    *,
+    field: str | None = None,
+    ax: plt.Axes | None = None,
+    fibres: Fibres | None = None,
+    title: str | None = None,
+    stress_unit: str = "stress",
+    value_range: Sequence[float] | None = None,
+    edges: bool = False,
+) -> plt.Figure:
+    """Draw a pattern ``(n, 2)``, optionally coloured by per-cell ``values`` (global order).
+
+    ``field`` names the values (for the colour bar label and a centred colour scale); ``fibres``
+    draws warp (solid) and fill (dashed) arrows; ``value_range`` fixes the colour scale.
+    """
+    if ax is None:
+        width, height = np.ptp(coordinates, axis=0)
+        aspect = float(np.clip(height / width, 0.3, 3.0)) if width > 0 else 1.0
+        size = (6.5, 6.5 * aspect * 0.85 + 0.6) if aspect <= 1 else (6.5 / aspect + 1.5, 6.5)
+        fig, ax = plt.subplots(figsize=size, layout="constrained")
+    fig = ax.figure
+    polygons = _polygons(mesh, coordinates)
+    if values is None:
+        collection = PolyCollection(
+            polygons, facecolors="#d9e6f2", edgecolors="#5b7a99", linewidths=0.2
+        )
+        ax.add_collection(collection)
+    else:
+        values = np.asarray(values, dtype=float)
+        low, high = (
+            value_range if value_range is not None else (np.nanmin(values), np.nanmax(values))
+        )
+        centre = _CENTRED.get(field)
+        if centre is not None and low < centre < high:
+            norm = TwoSlopeNorm(centre, low, high)
+            cmap = "RdBu_r"
+        else:
+            norm = Normalize(low, high if high > low else low + 1e-12)
+            cmap = "viridis"
+        collection = PolyCollection(
+            polygons,
+            array=values,
+            cmap=cmap,
+            norm=norm,
+            edgecolors="k" if edges else "face",
+            linewidths=0.1 if edges else 0.3,
+        )
+        ax.add_collection(collection)
+        label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
+        fig.colorbar(collection, ax=ax, label=label, shrink=0.85)
+    boundary = mesh.boundary_edges()
+    for a, b in boundary:
+        ax.plot(*coordinates[[a, b]].T, color="k", linewidth=0.6)
+    if fibres is not None:
+        centre = coordinates.mean(axis=0)
+        size = 0.15 * np.ptp(coordinates, axis=0).max()
+        for direction, style, name in ((fibres.warp, "-", "warp"), (fibres.fill, "--", "fill")):
+            ax.annotate(
+                "",
+                xy=centre + size * direction,
+                xytext=centre,
+                arrowprops={"arrowstyle": "->", "linestyle": style, "color": "k", "lw": 1.4},
+            )
+            ax.text(*(centre + 1.12 * size * direction), name, ha="center", va="center")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+def save_pattern_figure(path, *args, dpi: int = 150, **kwargs) -> None:
+    """:func:`plot_pattern` straight to a file (PNG, SVG, PDF by suffix)."""
+    fig = plot_pattern(*args, **kwargs)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)

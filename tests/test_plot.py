@@ -1,0 +1,41 @@
+import numpy as np
+import pytest
+
+import vares
+from vares.analysis import FIELD_DESCRIPTIONS
+from vares.examples import hypar
+from vares.plot import FIELD_LABELS, plot_pattern, save_pattern_figure
+
+
+def test_every_field_has_a_colour_bar_label():
+    assert set(FIELD_LABELS) == set(FIELD_DESCRIPTIONS)
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+def test_pattern_figures_are_written(tmp_path, suffix):
+    mesh = hypar(n=6, cell_type="quad")
+    result = vares.solve(mesh, vares.materials.NeoHooke(1000.0, 0.3))
+    path = tmp_path / f"det_F{suffix}"
+    save_pattern_figure(
+        path,
+        mesh,
+        result.material_coordinates,
+        result.fields["det_F"],
+        field="det_F",
+        fibres=result.fibres,
+        title="hypar",
+    )
+    assert path.stat().st_size > 5000
+    head = path.read_bytes()[:8]
+    assert head.startswith(b"\x89PNG") if suffix == ".png" else b"<?xml" in head
+
+
+def test_colour_scale_is_centred_on_the_neutral_value():
+    mesh = hypar(n=4)
+    x = vares.projection_plane(mesh).project(mesh.points)
+    values = np.linspace(0.9, 1.3, mesh.num_cells)
+    fig = plot_pattern(mesh, x, values, field="det_F")
+    collection = fig.axes[0].collections[0]
+    assert collection.norm.vcenter == 1.0
+    assert collection.norm.vmin == pytest.approx(0.9) and collection.norm.vmax == pytest.approx(1.3)
+    assert fig.axes[1].get_ylabel().startswith("det F")
