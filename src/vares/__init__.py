@@ -14,7 +14,7 @@ from . import examples, materials
 from .analysis import PatternEvaluation, cell_fields, evaluate
 from .initial import ProjectionPlane, projection_plane
 from .materials import Fibres
-from .mesh import MeshError, SurfaceMesh, read_mesh
+from .mesh import MeshError, SurfaceMesh, read_mesh, read_mesh_data
 from .problem import Problem
 from .solver import IterationRecord, PatternResult, StepRecord, solve
 
@@ -36,5 +36,6 @@ __all__ = [
     "materials",
     "projection_plane",
     "read_mesh",
+    "read_mesh_data",
     "solve",
 ]

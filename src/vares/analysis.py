@@ -29,6 +29,8 @@ FIELD_DESCRIPTIONS: dict[str, tuple[str, str]] = {
     "warp_stretch": ("stretch along the warp, √I4", "1"),
     "fill_stretch": ("stretch along the fill, √I6", "1"),
     "shear_angle": ("yarn shear angle: decrease of the angle between the yarns", "degree"),
+    "warp_compensation": ("compensation along the warp: 1 − pattern/erected length", "%"),
+    "fill_compensation": ("compensation along the fill: 1 − pattern/erected length", "%"),
     "warp_stress": ("Cauchy stress along the erected warp", "stress"),
     "fill_stress": ("Cauchy stress along the erected fill", "stress"),
     "warp_stress_pk2": ("2nd Piola–Kirchhoff stress Φ₁·SΦ₁ along the warp", "stress"),
@@ -112,6 +114,8 @@ def cell_fields(
         fill_cauchy = mean(np.einsum("a,mqab,b->mq", fibres.fill, CSC, fibres.fill) / (i6 * det_f))
         per_block["warp_stretch"].append(mean(np.sqrt(i4)))
         per_block["fill_stretch"].append(mean(np.sqrt(i6)))
+        per_block["warp_compensation"].append(mean(100.0 * (1.0 - 1.0 / np.sqrt(i4))))
+        per_block["fill_compensation"].append(mean(100.0 * (1.0 - 1.0 / np.sqrt(i6))))
         per_block["shear_angle"].append(mean(reference_angle - yarn_angle))
         per_block["warp_stress"].append(warp_cauchy)
         per_block["fill_stress"].append(fill_cauchy)

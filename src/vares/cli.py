@@ -19,6 +19,7 @@ from rich.table import Table
 
 from . import examples as example_surfaces
 from .analysis import evaluate as evaluate_pattern
+from .compensation import compensation_report
 from .io import (
     OutputExistsError,
     check_writable,
@@ -28,8 +29,9 @@ from .io import (
     write_json,
     write_surface,
 )
-from .materials import LAWS, Hyperelastic, MaterialError, make_material
-from .mesh import MeshError, SurfaceMesh, read_mesh
+from .materials import LAWS, Hyperelastic, MaterialError, load_presets, make_material, presets
+from .materials import fabric as fabric_preset
+from .mesh import MeshError, SurfaceMesh, read_mesh_data
 from .solver import IterationRecord, PatternResult, solve
 
 app = typer.Typer(
@@ -114,6 +116,39 @@ COption = Annotated[str | None, _opt("--C", help="NCF shear coefficients 'C1,C2,
 ThicknessOption = Annotated[
     float, _opt("--thickness", "-t", help="Thickness; 1 for laws given as force/length.", **_PANEL)
 ]
+FabricOption = Annotated[
+    str | None,
+    _opt("--fabric", help="Fabric preset (see 'vares fabrics'); replaces --material.", **_PANEL),
+]
+PresetsOption = Annotated[
+    Path | None, _opt("--presets", help="TOML file with your own fabric presets.", **_PANEL)
+]
+_PRESTRESS = {"rich_help_panel": "Prestress"}
+PrestressOption = Annotated[
+    str | None,
+    _opt(
+        "--prestress",
+        help="Prestress along the yarns, force/length: 'WARP,FILL' or one value for both.",
+        **_PRESTRESS,
+    ),
+]
+PrestressFieldOption = Annotated[
+    str | None,
+    _opt(
+        "--prestress-field",
+        help="Per-cell prestress from the input's cell data: 'NAME' "
+        "(columns warp, fill[, shear]) or 'WARP_NAME,FILL_NAME'.",
+        **_PRESTRESS,
+    ),
+]
+SlackOption = Annotated[
+    float,
+    _opt(
+        "--slack-threshold",
+        help="Report cells whose achieved yarn force is below this (force/length).",
+        **_PRESTRESS,
+    ),
+]
 _FIBRES = {"rich_help_panel": "Fibres"}
 WarpAngleOption = Annotated[
     float, _opt("--warp-angle", help="Warp angle in the pattern frame, degrees.", **_FIBRES)
@@ -171,7 +206,21 @@ class MaterialOptions:
     B: str | None
     C: str | None
 
+    fabric: str | None = None
+    presets: Path | None = None
+
     def build(self) -> Hyperelastic:
+        if self.fabric is not None:
+            given = [
+                n
+                for n in ("E", "nu", "mu", "E1", "E2", "G12", "nu12", "A", "B", "C")
+                if getattr(self, n) is not None
+            ]
+            if given or str(self.law) != "neo-hooke":
+                raise InputError("--fabric sets the material; drop --material and its parameters")
+            return fabric_preset(self.fabric, self.presets).material()
+        if self.presets is not None:
+            raise InputError("--presets needs --fabric")
         law = str(self.law)
         given = {
             "E": self.E,
@@ -205,6 +254,33 @@ def _vector(option: str, text: str) -> np.ndarray:
     if len(values) != 3:
         raise InputError(f"{option}: expected three numbers 'x,y,z'; got {text!r}")
     return np.array(values)
+
+
+def _prestress(
+    text: str | None, field: str | None, cell_data: dict[str, np.ndarray] | None
+) -> np.ndarray | None:
+    if text is not None and field is not None:
+        raise InputError("give --prestress or --prestress-field, not both")
+    if text is not None:
+        values = _numbers("--prestress", text)
+        if len(values) not in (1, 2, 3):
+            raise InputError(f"--prestress: expected 'WARP,FILL' or one value; got {text!r}")
+        return np.array(values[0] if len(values) == 1 else values)
+    if field is None:
+        return None
+    if cell_data is None:
+        raise InputError("--prestress-field needs an input file with cell data")
+    names = field.split(",")
+    missing = [n for n in names if n not in cell_data]
+    if missing or len(names) > 3:
+        known = ", ".join(cell_data) or "none"
+        raise InputError(
+            f"--prestress-field: no cell data {', '.join(missing) or field!r} "
+            f"in the input (it has: {known})"
+        )
+    if len(names) == 1:
+        return cell_data[names[0]]
+    return np.column_stack([np.asarray(cell_data[n], dtype=float).ravel() for n in names])
 
 
 def _plane(text: str):
@@ -248,7 +324,35 @@ def _field_table(fields: dict[str, np.ndarray]) -> Table:
     return table
 
 
-def _report(result: PatternResult, outputs: list[Path]) -> None:
+def _compensation_table(report) -> Table:
+    table = Table(
+        "",
+        "warp",
+        "fill",
+        title="compensation and prestress (force per length; means area-weighted)",
+    )
+    w, f = report.warp, report.fill
+    rows = [
+        ("compensation, mean", lambda y: f"{y.compensation_mean:.3f} %"),
+        (
+            "compensation, min … max",
+            lambda y: f"{y.compensation_min:.3f} … {y.compensation_max:.3f} %",
+        ),
+        ("target prestress", lambda y: f"{y.target_mean:.4g}"),
+        ("achieved, mean", lambda y: f"{y.achieved_mean:.4g}"),
+        ("achieved, min … max", lambda y: f"{y.achieved_min:.4g} … {y.achieved_max:.4g}"),
+        ("RMS deviation from target", lambda y: f"{y.rms_deviation:.3g}"),
+        (
+            f"slack: below {report.slack_threshold:g}",
+            lambda y: f"{100 * y.slack_area_fraction:.1f} % ({y.slack_cells} cells)",
+        ),
+    ]
+    for label, cell in rows:
+        table.add_row(label, cell(w), cell(f))
+    return table
+
+
+def _report(result: PatternResult, outputs: list[Path], report=None) -> None:
     status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
     console.print(
         f"{status} in {result.iterations} iterations ({' → '.join(result.strategy)}), "
@@ -257,6 +361,8 @@ def _report(result: PatternResult, outputs: list[Path]) -> None:
     )
     if result.converged:
         console.print(_field_table(result.fields))
+        if report is not None:
+            console.print(_compensation_table(report))
         if result.warp_deviation is not None:
             console.print(
                 f"mean deviation of the warp from the direction: {result.warp_deviation:.2e}°"
@@ -305,6 +411,8 @@ def _solve_and_write(
     fill_angle: float | None,
     warp_direction: str | None,
     orientation: Orientation,
+    prestress: np.ndarray | None,
+    slack_threshold: float,
     strategy: Strategy,
     steps: int,
     plane: str,
@@ -333,6 +441,7 @@ def _solve_and_write(
         fill_angle=fill_angle,
         warp_direction=direction,
         orientation=str(orientation),
+        prestress=prestress,
         strategy=str(strategy),
         steps=steps,
         plane=_plane(plane),
@@ -345,7 +454,10 @@ def _solve_and_write(
         write_surface(paths["surface"], mesh)
         written.append(paths["surface"])
     data = summary(result, input=input_name, tolerance=tolerance)
+    report = None
     if result.converged:
+        report = compensation_report(result, slack_threshold)
+        data["compensation"] = report.to_dict()
         write_surface(paths["pattern"], mesh, result.material_coordinates)
         write_surface(paths["pattern_vtu"], mesh, result.material_coordinates, result.fields)
         write_surface(paths["surface_vtu"], mesh, fields=result.fields)
@@ -353,7 +465,7 @@ def _solve_and_write(
     write_json(paths["summary"], data)
     written.append(paths["summary"])
     if not quiet:
-        _report(result, written)
+        _report(result, written, report)
     if not result.converged:
         raise typer.Exit(_fail(f"the solve did not converge: {result.reason}", 1))
 
@@ -374,11 +486,16 @@ def pattern(
     A: AOption = None,
     B: BOption = None,
     C: COption = None,
+    fabric: FabricOption = None,
+    presets_file: PresetsOption = None,
     thickness: ThicknessOption = 1.0,
     warp_angle: WarpAngleOption = 0.0,
     fill_angle: FillAngleOption = None,
     warp_direction: WarpDirectionOption = None,
     orientation: OrientationOption = Orientation.held,
+    prestress: PrestressOption = None,
+    prestress_field: PrestressFieldOption = None,
+    slack_threshold: SlackOption = 0.0,
     strategy: StrategyOption = Strategy.auto,
     steps: StepsOption = 3,
     plane: Annotated[
@@ -400,11 +517,11 @@ def pattern(
     OUTPUT/pattern.vtu and OUTPUT/surface.vtu (pattern and surface with every per-cell result,
     for ParaView) and OUTPUT/summary.json (convergence, energy, areas, field ranges, history).
     """
-    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C)
+    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C, fabric, presets_file)
 
     def body() -> None:
         built = options.build()
-        mesh = read_mesh(input)
+        mesh, cell_data = read_mesh_data(input)
         _solve_and_write(
             mesh,
             output,
@@ -416,6 +533,8 @@ def pattern(
             fill_angle=fill_angle,
             warp_direction=warp_direction,
             orientation=orientation,
+            prestress=_prestress(prestress, prestress_field, cell_data),
+            slack_threshold=slack_threshold,
             strategy=strategy,
             steps=steps,
             plane=plane,
@@ -446,11 +565,16 @@ def example(
     A: AOption = None,
     B: BOption = None,
     C: COption = None,
+    fabric: FabricOption = None,
+    presets_file: PresetsOption = None,
     thickness: ThicknessOption = 1.0,
     warp_angle: WarpAngleOption = 0.0,
     fill_angle: FillAngleOption = None,
     warp_direction: WarpDirectionOption = None,
     orientation: OrientationOption = Orientation.held,
+    prestress: PrestressOption = None,
+    prestress_field: PrestressFieldOption = None,
+    slack_threshold: SlackOption = 0.0,
     strategy: StrategyOption = Strategy.auto,
     steps: StepsOption = 3,
     plane: Annotated[
@@ -462,7 +586,7 @@ def example(
     quiet: QuietOption = False,
 ) -> None:
     """Write a shipped example surface (OUTPUT/surface.obj) and compute its pattern."""
-    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C)
+    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C, fabric, presets_file)
 
     def body() -> None:
         if name not in example_surfaces.EXAMPLES:
@@ -482,6 +606,8 @@ def example(
             fill_angle=fill_angle,
             warp_direction=warp_direction,
             orientation=orientation,
+            prestress=_prestress(prestress, prestress_field, None),
+            slack_threshold=slack_threshold,
             strategy=strategy,
             steps=steps,
             plane=plane or example_surfaces.EXAMPLE_PLANES.get(name, "best-fit"),
@@ -512,6 +638,8 @@ def evaluate(
     A: AOption = None,
     B: BOption = None,
     C: COption = None,
+    fabric: FabricOption = None,
+    presets_file: PresetsOption = None,
     thickness: ThicknessOption = 1.0,
     warp_angle: WarpAngleOption = 0.0,
     fill_angle: FillAngleOption = None,
@@ -523,11 +651,11 @@ def evaluate(
     Reports where the yarns go into compression (where a ply cut from this pattern wrinkles)
     and writes OUTPUT/evaluation.json and OUTPUT/evaluation.vtu.
     """
-    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C)
+    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C, fabric, presets_file)
 
     def body() -> None:
         built = options.build()
-        mesh = read_mesh(surface)
+        mesh = read_mesh_data(surface)[0]
         coordinates = read_pattern(pattern_file, mesh)
         paths = [output / "evaluation.json", output / "evaluation.vtu"]
         check_writable(paths, force)
@@ -539,7 +667,7 @@ def evaluate(
         data = {
             "surface": str(surface),
             "pattern": str(pattern_file),
-            "material": {"law": str(material), **built.parameters},
+            "material": {"law": type(built).__name__, **built.parameters},
             "warp_angle": warp_angle,
             "fill_angle": fill_angle if fill_angle is not None else warp_angle + 90.0,
             "energy": result.energy,
@@ -557,5 +685,33 @@ def evaluate(
             )
             for path in paths:
                 console.print(f"  wrote {path}")
+
+    _guarded(body)
+
+
+@app.command()
+def fabrics(
+    presets_file: PresetsOption = None,
+) -> None:
+    """List the fabric presets (typical values: use your own biaxial test values to cut)."""
+
+    def body() -> None:
+        catalogue = presets() | (load_presets(presets_file) if presets_file else {})
+        table = Table(
+            "preset",
+            "E1 (warp)",
+            "E2 (fill)",
+            "G12",
+            "nu12",
+            "description",
+            title="fabric presets: stiffness E·t as force per length (thickness 1)",
+        )
+        for name, p in catalogue.items():
+            table.add_row(
+                name, f"{p.E1:g}", f"{p.E2:g}", f"{p.G12:g}", f"{p.nu12:g}", p.description
+            )
+        Console(highlight=False).print(table)
+        for name, p in catalogue.items():
+            Console(highlight=False, soft_wrap=True).print(f"{name}: {p.source}")
 
     _guarded(body)

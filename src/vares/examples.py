@@ -7,6 +7,9 @@
 ``hypar``
     A hyperbolic paraboloid ``z = c x y`` over a square: doubly curved (anticlastic), the shape
     of a four-point sail.
+``sail``, ``tent``
+    A four-point sail (a hypar with two high and two low corners) and one panel of a conic tent
+    pulled up to a central ring: the prestressed membranes of the compensation examples.
 ``rib30``
     A generic 30° segment of a curved composite rib (seed §5.2): a hat-shaped cross-section
     (web, inclined walls, flanges, rounded corners) swept along a circular arc. The rounded
@@ -22,7 +25,16 @@ import numpy as np
 
 from .mesh import SurfaceMesh
 
-__all__ = ["EXAMPLES", "cylinder160", "cylinder_arc_length", "grid_cells", "hypar", "rib30"]
+__all__ = [
+    "EXAMPLES",
+    "conic_tent",
+    "cylinder160",
+    "cylinder_arc_length",
+    "four_point_sail",
+    "grid_cells",
+    "hypar",
+    "rib30",
+]
 
 
 def grid_cells(n_u: int, n_v: int, cell_type: str = "triangle") -> dict[str, np.ndarray]:
@@ -174,11 +186,62 @@ def rib30(
     return SurfaceMesh(points, grid_cells(len(profile), len(phi), cell_type))
 
 
+def four_point_sail(
+    size: float = 10.0,
+    height: float = 2.0,
+    n: int = 24,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """A four-point sail: the hyperbolic paraboloid over a ``size`` × ``size`` square whose
+    opposite corners are ``height`` apart (two high, two low), ``z = 2 height x y / size²``.
+    """
+    return hypar(size=size, rise=2.0 * height / size**2, n=n, cell_type=cell_type)
+
+
+def conic_tent(
+    outer_radius: float = 10.0,
+    ring_radius: float = 1.5,
+    height: float = 6.0,
+    panels: int = 12,
+    n_radial: int = 40,
+    n_around: int = 16,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """One panel of a conic tent: a membrane pulled up to a central ring.
+
+    The surface of revolution ``z = height · ln(R/ρ) / ln(R/r)`` (``R = outer_radius`` at
+    ground level, ``r = ring_radius`` at the top) is the equilibrium shape of a radially
+    tensioned tent; the panel spans ``360°/panels`` about the x-axis (``panels = 1``: the whole
+    tent, a ring). Radial spacing is uniform in ``ln ρ``, so cells are finer at the ring.
+    """
+    if not 0 < ring_radius < outer_radius:
+        raise ValueError("the ring radius must lie between 0 and the outer radius")
+    if panels < 1:
+        raise ValueError(f"panels must be a positive integer; got {panels}")
+    rho = np.exp(np.linspace(np.log(ring_radius), np.log(outer_radius), n_radial + 1))
+    z = height * np.log(outer_radius / rho) / np.log(outer_radius / ring_radius)
+    whole = panels == 1
+    span = 2 * np.pi / panels
+    count = n_around * (4 if whole else 1)
+    phi = np.linspace(-span / 2, span / 2, count + 1)[: -1 if whole else None]
+    r, p = np.meshgrid(rho, phi, indexing="xy")
+    points = np.column_stack(
+        [(r * np.cos(p)).ravel(), (r * np.sin(p)).ravel(), np.tile(z, len(phi))]
+    )
+    n_u = len(rho)
+    cells = grid_cells(n_u, len(phi) + (1 if whole else 0), cell_type)
+    if whole:  # close the ring: the last row of nodes is the first
+        cells = {t: np.where(c >= len(points), c - len(points), c) for t, c in cells.items()}
+    return SurfaceMesh(points, cells)
+
+
 #: Example generators by name (used by ``vares example``).
 EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {
     "cylinder160": cylinder160,
     "hypar": hypar,
     "rib30": rib30,
+    "sail": four_point_sail,
+    "tent": conic_tent,
 }
 #: The initial-guess plane each example is meant to be patterned with.
 EXAMPLE_PLANES = {"cylinder160": "xy"}

@@ -19,7 +19,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .elements import ELEMENTS
 
-__all__ = ["MeshError", "SurfaceMesh", "read_mesh"]
+__all__ = ["MeshError", "SurfaceMesh", "read_mesh", "read_mesh_data"]
 
 #: Cell types of meshio that are ignored when reading a surface (lower-dimensional helpers).
 _IGNORED_CELL_TYPES = {"vertex", "line", "line3"}
@@ -345,6 +345,15 @@ def read_mesh(path: str | Path) -> SurfaceMesh:
     MeshError
         The file cannot be read as a mesh, or the mesh is not a valid surface.
     """
+    return read_mesh_data(path)[0]
+
+
+def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]]:
+    """:func:`read_mesh`, and the file's cell data in the mesh's global cell order.
+
+    Each cell data array has shape ``(num_cells,)`` or ``(num_cells, k)``; arrays that exist
+    only on some cell blocks are left out.
+    """
     import meshio
 
     path = Path(path)
@@ -362,7 +371,8 @@ def read_mesh(path: str | Path) -> SurfaceMesh:
         raise MeshError(f"cannot read {path}: {type(exc).__name__}: {exc}") from exc
 
     cells: dict[str, list[np.ndarray]] = {}
-    for block in raw.cells:
+    data: dict[str, dict[str, list[np.ndarray]]] = {}
+    for index, block in enumerate(raw.cells):
         if block.type in _IGNORED_CELL_TYPES:
             continue
         if block.type not in ELEMENTS:
@@ -371,8 +381,15 @@ def read_mesh(path: str | Path) -> SurfaceMesh:
                 "triangles and/or quads"
             )
         cells.setdefault(block.type, []).append(np.asarray(block.data))
+        for name, arrays in raw.cell_data.items():
+            data.setdefault(name, {}).setdefault(block.type, []).append(np.asarray(arrays[index]))
     if not cells:
         raise MeshError(f"{path} contains no triangle or quad cells")
-    return SurfaceMesh(
+    mesh = SurfaceMesh(
         raw.points, {t: np.vstack(blocks) for t, blocks in cells.items()}, drop_unused_nodes=True
     )
+    cell_data = {}
+    for name, by_type in data.items():
+        if all(len(by_type.get(t, [])) == len(cells[t]) for t in cells):
+            cell_data[name] = np.concatenate([np.concatenate(by_type[t]) for t in cells])
+    return mesh, cell_data

@@ -28,6 +28,8 @@ FIELD_LABELS = {
     "warp_stretch": "warp stretch [-]",
     "fill_stretch": "fill stretch [-]",
     "shear_angle": "yarn shear angle [°]",
+    "warp_compensation": "warp compensation [%]",
+    "fill_compensation": "fill compensation [%]",
     "warp_stress": "warp stress (Cauchy) [{stress}]",
     "fill_stress": "fill stress (Cauchy) [{stress}]",
     "warp_stress_pk2": "warp stress (2nd P-K) [{stress}]",

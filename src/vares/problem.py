@@ -6,6 +6,7 @@ it knows nothing about how the pattern is found (see :mod:`vares.solver`).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,6 +15,7 @@ from .elements import ELEMENTS
 from .kernels import block_energy, determinant
 from .materials import Fibres, Hyperelastic, MaterialError
 from .mesh import SurfaceMesh
+from .prestress import prestress_components, prestress_tensor
 
 __all__ = ["Evaluation", "Problem"]
 
@@ -43,9 +45,8 @@ class Problem:
     fibres
         Warp/fill directions in the pattern plane; required for anisotropic laws.
     prestress
-        Second Piola–Kirchhoff prestress in the pattern frame: ``(2, 2)`` uniform or
-        ``(num_cells, 2, 2)`` per cell (global cell order), stress units (× thickness = force
-        per length).
+        Intended prestress along the yarns, force per length: a number (isotropic), (warp, fill
+        [, shear]) or one such row per cell (see :func:`vares.prestress.prestress_components`).
     points
         Surface node positions to use instead of ``mesh.points`` (pseudo-time stepping).
     """
@@ -74,26 +75,27 @@ class Problem:
         self.thickness = float(thickness)
         self.fibres = fibres
         self.points = mesh.points if points is None else np.asarray(points, dtype=float)
-        self.prestress = None if prestress is None else np.asarray(prestress, dtype=float)
+        self.prestress = prestress_components(prestress, mesh.num_cells)
+        if self.prestress is not None and fibres is None:
+            raise ValueError("a prestress along the yarns needs fibre directions")
         self._prestress_blocks = self._split_prestress(self.prestress)
         self._metrics = [ELEMENTS[t].metrics(self.points, cells) for t, cells in mesh.cells.items()]
 
-    def _split_prestress(self, prestress: np.ndarray | None) -> list[np.ndarray | None]:
+    def _split_prestress(self, components: np.ndarray | None) -> list[np.ndarray | None]:
+        """``S_pre`` per block, broadcastable to ``(m, q, 2, 2)``."""
         blocks = list(self.mesh.cells.values())
-        if prestress is None:
+        if components is None:
             return [None] * len(blocks)
-        if prestress.shape == (2, 2):
-            return [prestress] * len(blocks)
-        if prestress.shape != (self.mesh.num_cells, 2, 2):
-            raise ValueError(
-                f"prestress must have shape (2, 2) or ({self.mesh.num_cells}, 2, 2); "
-                f"got {prestress.shape}"
-            )
-        out, start = [], 0
-        for cells in blocks:
-            out.append(prestress[start : start + len(cells), None])  # (m, 1, 2, 2)
-            start += len(cells)
-        return out
+        tensor = prestress_tensor(components, self.fibres, self.thickness)
+        if len(tensor) == 1:
+            return [tensor[0]] * len(blocks)
+        bounds = np.cumsum([0] + [len(cells) for cells in blocks])
+        return [tensor[a:b, None] for a, b in itertools.pairwise(bounds)]
+
+    @property
+    def orientation_matters(self) -> bool:
+        """True when the energy depends on the yarn directions (anisotropic law or prestress)."""
+        return self.material.needs_fibres or self.prestress is not None
 
     def with_surface(self, points: np.ndarray, prestress_factor: float = 1.0) -> Problem:
         """The same problem on other surface positions, with the prestress scaled."""

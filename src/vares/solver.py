@@ -501,7 +501,7 @@ def _align_warp(
             break
         new_theta = theta - np.degrees(deviation / slope)
         fibres = Fibres.from_angles(new_theta, new_theta + offset)
-        if problem.material.needs_fibres:
+        if problem.orientation_matters:
             problem = make_problem(fibres)
             before = len(ctx.history)
             try:
@@ -562,7 +562,7 @@ def solve(
     fill_angle: float | None = None,
     warp_direction: Sequence[float] | np.ndarray | None = None,
     orientation: str = "held",
-    prestress: np.ndarray | None = None,
+    prestress: float | Sequence[float] | np.ndarray | None = None,
     strategy: str = "auto",
     steps: int = 3,
     initial_guess: np.ndarray | None = None,
@@ -590,11 +590,14 @@ def solve(
         this direction (projected on the surface) is zero, and the pattern is returned with the
         warp along +x. Overrides ``warp_angle`` (the fill keeps its angle to the warp).
     orientation
-        For anisotropic laws without ``warp_direction``: ``"held"`` (default) keeps the
-        pattern's rotation that of the initial guess, so the yarns run at ``warp_angle`` to the
+        For anisotropic laws or a prestress (whenever the energy depends on the yarn
+        directions) without ``warp_direction``: ``"held"`` (default) keeps the pattern's
+        rotation that of the initial guess, so the yarns run at ``warp_angle`` to the
         initial-guess plane's axes; ``"free"`` lets the energy choose the rotation.
     prestress
-        Second Piola–Kirchhoff prestress in the pattern frame (see :class:`Problem`).
+        Intended prestress along the yarns, force per length (e.g. kN/m): a number
+        (isotropic), ``(warp, fill)``, ``(warp, fill, shear)``, or one such row per cell. It
+        enters the energy as ``− S_pre : E`` and is ramped with the pseudo-time steps.
     strategy
         ``"auto"`` (default), ``"newton"``, ``"pseudo-time"`` or ``"damping"`` (module docs).
     steps
@@ -668,7 +671,7 @@ def solve(
         if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not direction.any():
             raise ValueError(f"warp_direction must be a non-zero 3-vector; got {warp_direction!r}")
 
-    rotation = "fixed" if not material.needs_fibres else orientation
+    rotation = orientation if problem.orientation_matters else "fixed"
     free, constraint = _rigid_modes(start, rotation)
     ctx = _Context(
         assembler=Assembler(mesh, free),

@@ -3,6 +3,7 @@
 from .anisotropic import NonCrimpFabric, OrthotropicStVenantKirchhoff
 from .base import INVARIANTS, Fibres, Hyperelastic, MaterialError, MaterialResponse
 from .isotropic import IncompressibleNeoHooke, NeoHooke, StVenantKirchhoff
+from .presets import FabricPreset, fabric, load_presets, presets
 
 #: Laws by the names used on the command line and in job files.
 LAWS: dict[str, type[Hyperelastic]] = {
@@ -37,6 +38,7 @@ def make_material(law: str, parameters: dict[str, object]) -> Hyperelastic:
 __all__ = [
     "INVARIANTS",
     "LAWS",
+    "FabricPreset",
     "Fibres",
     "Hyperelastic",
     "IncompressibleNeoHooke",
@@ -46,5 +48,8 @@ __all__ = [
     "NonCrimpFabric",
     "OrthotropicStVenantKirchhoff",
     "StVenantKirchhoff",
+    "fabric",
+    "load_presets",
     "make_material",
+    "presets",
 ]
