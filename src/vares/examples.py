@@ -27,13 +27,19 @@ from .mesh import SurfaceMesh
 
 __all__ = [
     "EXAMPLES",
+    "bumpy",
+    "cap_over_square",
+    "catenoid_section",
+    "cone_segment",
     "conic_tent",
     "cylinder160",
     "cylinder_arc_length",
     "four_point_sail",
+    "graded_hypar",
     "grid_cells",
     "hypar",
     "rib30",
+    "spherical_cap",
 ]
 
 
@@ -233,6 +239,142 @@ def conic_tent(
     if whole:  # close the ring: the last row of nodes is the first
         cells = {t: np.where(c >= len(points), c - len(points), c) for t, c in cells.items()}
     return SurfaceMesh(points, cells)
+
+
+def spherical_cap(
+    radius: float = 12.0,
+    half_angle: float = 60.0,
+    n_rings: int = 12,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """Spherical cap of ``half_angle`` degrees about the +z pole (90: a hemisphere, more: a
+    deep cap that turns by more than 180°), triangulated from rings of equal arc spacing.
+    """
+    if cell_type != "triangle":
+        raise ValueError("spherical_cap makes triangles only")
+    from scipy.spatial import Delaunay
+
+    if not 0 < half_angle < 180:
+        raise ValueError(f"half_angle must lie in (0, 180) degrees; got {half_angle}")
+    polar = [np.zeros((1, 2))]
+    for ring in range(1, n_rings + 1):
+        count = 6 * ring
+        phi = 2 * np.pi * (np.arange(count) + 0.5 * (ring % 2)) / count
+        polar.append(np.column_stack([np.full(count, ring / n_rings), phi]))
+    polar = np.vstack(polar)
+    theta = np.radians(half_angle) * polar[:, 0]
+    plane = np.column_stack([theta * np.cos(polar[:, 1]), theta * np.sin(polar[:, 1])])
+    triangles = Delaunay(plane).simplices
+    points = np.column_stack(
+        [
+            radius * np.sin(theta) * np.cos(polar[:, 1]),
+            radius * np.sin(theta) * np.sin(polar[:, 1]),
+            radius * np.cos(theta),
+        ]
+    )
+    return SurfaceMesh(points, {"triangle": _counter_clockwise(plane, triangles)})
+
+
+def _counter_clockwise(plane: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    a, b, c = plane[triangles[:, 0]], plane[triangles[:, 1]], plane[triangles[:, 2]]
+    cross = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
+    return np.where(cross[:, None] > 0, triangles, triangles[:, [0, 2, 1]])
+
+
+def cap_over_square(
+    size: float = 10.0, radius: float = 12.0, n: int = 20, cell_type: str = "triangle"
+) -> SurfaceMesh:
+    """The spherical cap of ``radius`` over the square ``[−size/2, size/2]²`` (synclastic)."""
+    s = np.linspace(-size / 2, size / 2, n + 1)
+    x, y = np.meshgrid(s, s, indexing="xy")
+    z = np.sqrt(radius**2 - x**2 - y**2)
+    points = np.column_stack([x.ravel(), y.ravel(), z.ravel() - z.min()])
+    return SurfaceMesh(points, grid_cells(n + 1, n + 1, cell_type))
+
+
+def cone_segment(
+    apex_angle: float = 60.0,
+    angle: float = 120.0,
+    inner: float = 1.0,
+    outer: float = 4.0,
+    n_radial: int = 12,
+    n_around: int = 24,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """Segment of a circular cone (developable): half opening ``apex_angle``/2, ``angle``
+    degrees around, slant distances ``inner`` … ``outer`` from the apex."""
+    half = np.radians(apex_angle) / 2
+    s = np.linspace(inner, outer, n_radial + 1)
+    phi = np.radians(np.linspace(-angle / 2, angle / 2, n_around + 1))
+    ss, pp = np.meshgrid(s, phi, indexing="xy")
+    r = ss * np.sin(half)
+    points = np.column_stack(
+        [(r * np.cos(pp)).ravel(), (r * np.sin(pp)).ravel(), -(ss * np.cos(half)).ravel()]
+    )
+    return SurfaceMesh(points, grid_cells(n_radial + 1, n_around + 1, cell_type))
+
+
+def catenoid_section(
+    waist: float = 2.0,
+    height: float = 3.0,
+    angle: float = 120.0,
+    n_along: int = 16,
+    n_around: int = 24,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """Section of a catenoid (a minimal surface: anticlastic, zero mean curvature) of waist
+    radius ``waist``, ``±height/2`` along its axis (z), ``angle`` degrees around."""
+    v = np.linspace(-height / 2, height / 2, n_along + 1)
+    phi = np.radians(np.linspace(-angle / 2, angle / 2, n_around + 1))
+    vv, pp = np.meshgrid(v, phi, indexing="xy")
+    r = waist * np.cosh(vv / waist)
+    points = np.column_stack([(r * np.cos(pp)).ravel(), (r * np.sin(pp)).ravel(), vv.ravel()])
+    return SurfaceMesh(points, grid_cells(n_along + 1, n_around + 1, cell_type))
+
+
+def bumpy(
+    size: float = 10.0,
+    amplitude: float = 0.6,
+    bumps: int = 12,
+    n: int = 24,
+    seed: int = 0,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """A square with ``bumps`` random Gaussian bumps and dents (reproducible by ``seed``)."""
+    rng = np.random.default_rng(seed)
+    s = np.linspace(-size / 2, size / 2, n + 1)
+    x, y = (a.ravel() for a in np.meshgrid(s, s, indexing="xy"))
+    centres = rng.uniform(-size / 2, size / 2, (bumps, 2))
+    widths = rng.uniform(0.08, 0.2, bumps) * size
+    heights = rng.uniform(-1.0, 1.0, bumps) * amplitude
+    z = sum(
+        h * np.exp(-((x - c[0]) ** 2 + (y - c[1]) ** 2) / (2 * w**2))
+        for c, w, h in zip(centres, widths, heights, strict=True)
+    )
+    return SurfaceMesh(np.column_stack([x, y, z]), grid_cells(n + 1, n + 1, cell_type))
+
+
+def graded_hypar(
+    size: float = 10.0,
+    rise: float = 0.06,
+    n: int = 20,
+    grading: float = 100.0,
+    sliver: float = 0.0,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """A hypar meshed with cells whose size varies by ``grading`` from one side to the other;
+    with ``sliver`` > 0 every other column of nodes is moved to within ``sliver`` × the local
+    spacing of its neighbour, making cells of aspect ratio about 1/``sliver`` (slivers)."""
+    ratio = grading ** (1.0 / (n - 1))
+    steps = ratio ** np.arange(n)
+    u = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
+    if sliver > 0:
+        du = np.diff(u)
+        u[1:-1:2] = u[0:-2:2] + sliver * du[0:-1:2]
+    s = size * (u - 0.5)
+    t = np.linspace(-size / 2, size / 2, n + 1)
+    x, y = (a.ravel() for a in np.meshgrid(s, t, indexing="xy"))
+    return SurfaceMesh(np.column_stack([x, y, rise * x * y]), grid_cells(n + 1, n + 1, cell_type))
 
 
 #: Example generators by name (used by ``vares example``).

@@ -71,6 +71,7 @@ def block_energy(
     fibres: Fibres | None = None,
     prestress: np.ndarray | None = None,
     order: int = 2,
+    projected: bool = False,
 ) -> BlockResult:
     """Energy (and gradient for ``order ≥ 1``, Hessian for ``order = 2``) of a block of cells.
 
@@ -86,6 +87,10 @@ def block_energy(
         The law, the thickness (energy per area = thickness × Ψ) and the fibre directions.
     prestress
         Second Piola–Kirchhoff prestress in the pattern frame, broadcastable to ``(m, q, 2, 2)``.
+    projected
+        Return the Hessian with the negative eigenvalues of each quadrature point's ``∂²W/∂J²``
+        set to zero: positive semi-definite, for Newton steps far from the solution (real
+        arithmetic only).
 
     The caller ensures ``det J > 0`` (see :meth:`vares.problem.Problem.inverted_cells`).
     """
@@ -106,7 +111,7 @@ def block_energy(
     if order == 0:
         return BlockResult(energy, None, None)
     tangent = response.tangent if order >= 2 else np.zeros((1, 1, 2, 2, 2, 2), dtype)
-    gradient, hessian = _derivatives(
+    gradient, jacobian_hessian = _derivatives(
         det_j,
         K,
         C,
@@ -117,7 +122,12 @@ def block_energy(
         scale,
         order >= 2,
     )
-    return BlockResult(energy, gradient, hessian if order >= 2 else None)
+    if order < 2:
+        return BlockResult(energy, gradient, None)
+    if projected:
+        _project_psd(jacobian_hessian)
+    shape_gradients = np.ascontiguousarray(element.shape_gradients, dtype=dtype)
+    return BlockResult(energy, gradient, _nodal_hessian(jacobian_hessian, shape_gradients, scale))
 
 
 @njit(cache=True)
@@ -164,18 +174,18 @@ def _kinematics(pattern_nodes, shape_gradients, metric):  # pragma: no cover - c
 def _derivatives(
     det_j, K, C, psi, S, tangent, shape_gradients, scale, with_hessian
 ):  # pragma: no cover
-    """Nodal gradient and Hessian from the Eshelby form and its directional derivatives."""
+    """Nodal gradient, and the Hessian of ``W(J)`` at each quadrature point, ``(m, q, 4, 4)``
+    with index ``2 i + α`` for ``J_iα``, from the Eshelby form and its directional derivatives."""
     m, nq = det_j.shape
     nen = shape_gradients.shape[1]
     dtype = det_j.dtype
     gradient = np.zeros((m, nen, 2), dtype)
-    hessian = np.zeros((m, nen, 2, nen, 2) if with_hessian else (1, 1, 1, 1, 1), dtype)
+    jacobian_hessian = np.zeros((m, nq, 4, 4) if with_hessian else (1, 1, 4, 4), dtype)
     sigma = np.empty((2, 2), dtype)
     sigma_kt = np.empty((2, 2), dtype)
     dC = np.empty((2, 2), dtype)
     dS = np.empty((2, 2), dtype)
     d_sigma = np.empty((2, 2), dtype)
-    dg = np.empty((2, 2, 2, 2), dtype)  # (l, β, k, α): ∂g_kα / ∂J_lβ
     for e in range(m):
         for q in range(nq):
             d = det_j[e, q]
@@ -241,18 +251,98 @@ def _derivatives(
                             value += d_sigma[a, 0] * k[b, 0] + d_sigma[a, 1] * k[b, 1]
                             # (Lᵀ Kᵀ)_{pb} = L_{rp} K_{br} = K_{αp} K_{bi}
                             value -= (sigma[a, 0] * k[al, 0] + sigma[a, 1] * k[al, 1]) * k[b, i]
-                            dg[i, al, a, b] = d * value
+                            # ∂g_ab / ∂J_i,al
+                            jacobian_hessian[e, q, 2 * i + al, 2 * a + b] = d * value
+    return gradient, jacobian_hessian
+
+
+@njit(cache=True)
+def _nodal_hessian(jacobian_hessian, shape_gradients, scale):  # pragma: no cover
+    """``Σ_q w_q Bᵀ H_q B``: nodal Hessian ``(m, nen, 2, nen, 2)`` from ``(m, q, 4, 4)``."""
+    m, nq = jacobian_hessian.shape[0], jacobian_hessian.shape[1]
+    nen = shape_gradients.shape[1]
+    hessian = np.zeros((m, nen, 2, nen, 2), jacobian_hessian.dtype)
+    for e in range(m):
+        for q in range(nq):
+            h = jacobian_hessian[e, q]
+            w = scale[q]
             for a in range(nen):
                 for kk in range(2):
                     for b in range(nen):
                         for ll in range(2):
-                            value = 0.0 * d
+                            value = 0.0 * h[0, 0]
                             for al in range(2):
                                 for be in range(2):
                                     value += (
                                         shape_gradients[q, a, al]
-                                        * dg[ll, be, kk, al]
+                                        * h[2 * ll + be, 2 * kk + al]
                                         * shape_gradients[q, b, be]
                                     )
                             hessian[e, a, kk, b, ll] += w * value
-    return gradient, hessian
+    return hessian
+
+
+@njit(cache=True)
+def _project_psd(jacobian_hessian):  # pragma: no cover
+    """Set the negative eigenvalues of every 4 × 4 block to zero, in place (cyclic Jacobi).
+
+    Blocks with a positive, diagonally dominant diagonal are positive semi-definite already and
+    are left alone.
+    """
+    a = np.empty((4, 4))
+    v = np.empty((4, 4))
+    for e in range(jacobian_hessian.shape[0]):
+        for q in range(jacobian_hessian.shape[1]):
+            h = jacobian_hessian[e, q]
+            dominant = True
+            for r in range(4):
+                off = 0.0
+                for c in range(4):
+                    if c != r:
+                        off += abs(0.5 * (h[r, c] + h[c, r]))
+                if h[r, r] < off:
+                    dominant = False
+            if dominant:
+                continue
+            scale = 0.0
+            for r in range(4):
+                for c in range(4):
+                    a[r, c] = 0.5 * (h[r, c] + h[c, r])
+                    v[r, c] = 1.0 if r == c else 0.0
+                    scale += a[r, c] * a[r, c]
+            for _sweep in range(30):
+                off = 0.0
+                for r in range(3):
+                    for c in range(r + 1, 4):
+                        off += a[r, c] * a[r, c]
+                if off <= 1e-30 * scale:
+                    break
+                for p in range(3):
+                    for r in range(p + 1, 4):
+                        if a[p, r] == 0.0:
+                            continue
+                        theta = (a[r, r] - a[p, p]) / (2.0 * a[p, r])
+                        t = (1.0 if theta >= 0 else -1.0) / (
+                            abs(theta) + np.sqrt(theta * theta + 1.0)
+                        )
+                        cos = 1.0 / np.sqrt(t * t + 1.0)
+                        sin = t * cos
+                        for k in range(4):  # A ← A G (columns p, r)
+                            akp, akr = a[k, p], a[k, r]
+                            a[k, p] = cos * akp - sin * akr
+                            a[k, r] = sin * akp + cos * akr
+                        for k in range(4):  # A ← Gᵀ A (rows p, r)
+                            apk, ark = a[p, k], a[r, k]
+                            a[p, k] = cos * apk - sin * ark
+                            a[r, k] = sin * apk + cos * ark
+                        for k in range(4):
+                            vkp, vkr = v[k, p], v[k, r]
+                            v[k, p] = cos * vkp - sin * vkr
+                            v[k, r] = sin * vkp + cos * vkr
+            for r in range(4):
+                for c in range(4):
+                    value = 0.0
+                    for k in range(4):
+                        if a[k, k] > 0.0:
+                            value += v[r, k] * a[k, k] * v[c, k]
+                    h[r, c] = value

@@ -110,10 +110,14 @@ class Problem:
         )
 
     # ------------------------------------------------------------------ evaluation
-    def evaluate(self, coordinates: np.ndarray, order: int = 2) -> Evaluation:
+    def evaluate(
+        self, coordinates: np.ndarray, order: int = 2, *, projected: bool = False
+    ) -> Evaluation:
         """Energy (and per-block gradients for ``order ≥ 1``, Hessians for ``order = 2``).
 
-        ``coordinates`` is the pattern ``(n, 2)``; it must not invert any cell.
+        ``coordinates`` is the pattern ``(n, 2)``; it must not invert any cell. With
+        ``projected`` the Hessians are made positive semi-definite quadrature point by
+        quadrature point (see :func:`vares.kernels.block_energy`).
         """
         energies, gradients, hessians = [], [], []
         for (cell_type, cells), metric, prestress in zip(
@@ -128,6 +132,7 @@ class Problem:
                 fibres=self.fibres,
                 prestress=prestress,
                 order=order,
+                projected=projected,
             )
             energies.append(block.energy)
             gradients.append(block.gradient)

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 
 from .assembly import Assembler
 from .elements import ELEMENTS
-from .initial import PlaneSpec, ProjectionPlane, projection_plane
+from .initial import PlaneSpec, ProjectionPlane, lscm, projection_distortion, projection_plane
 from .kernels import determinant
 from .linalg import LinearSolver, SingularMatrixError, get_solver
 from .materials import Fibres, Hyperelastic
@@ -44,10 +44,13 @@ __all__ = ["STRATEGIES", "IterationRecord", "PatternResult", "StepRecord", "solv
 
 STRATEGIES = ("auto", "newton", "pseudo-time", "damping")
 ORIENTATIONS = ("held", "free")
+INITIAL_GUESSES = ("auto", "projection", "lscm")
+#: Below this smallest projected/3D area ratio (about 78° of slope) the projection is no start.
+_PROJECTION_MIN_AREA_RATIO = 0.2
 #: The mean erected warp follows a prescribed direction to this angle (radians).
 _ALIGNMENT_TOLERANCE = 1e-10
 #: Relative residual below which globalised Newton returns from projected to exact tangents.
-_EXACT_TANGENT_BELOW = 1e-3
+_EXACT_TANGENT_BELOW = 1e-2
 
 
 @dataclass(frozen=True)
@@ -106,6 +109,8 @@ class PatternResult:
         The path taken, e.g. ``["pseudo-time"]`` or ``["pseudo-time", "damping"]``.
     fibres
         Warp and fill directions in the pattern frame.
+    initial_guess
+        Where the solve started: ``"projection"``, ``"lscm"`` or ``"given"``.
     warp_direction, warp_deviation
         The prescribed 3D warp direction (or None) and the final 3D-area-weighted mean angle
         (degrees) between it and the erected warp.
@@ -127,6 +132,7 @@ class PatternResult:
     prestress: np.ndarray | None = None
     plane: ProjectionPlane | None = None
     orientation: str = "held"
+    initial_guess: str = "projection"
     warp_direction: np.ndarray | None = None
     warp_deviation: float | None = None
     _fields: dict[str, np.ndarray] | None = field(default=None, repr=False)
@@ -242,18 +248,6 @@ def _step_bound(problem: Problem, x: np.ndarray, delta: np.ndarray) -> float:
     return bound
 
 
-def _project_psd(hessians: list[np.ndarray]) -> list[np.ndarray]:
-    """Element Hessians with their negative eigenvalues set to zero (projected Newton)."""
-    out = []
-    for h in hessians:
-        shape = h.shape
-        k = shape[1] * shape[2]
-        values, vectors = np.linalg.eigh(h.reshape(-1, k, k))
-        projected = np.einsum("mik,mk,mjk->mij", vectors, np.maximum(values, 0.0), vectors)
-        out.append(projected.reshape(shape))
-    return out
-
-
 def _newton(
     problem: Problem,
     coordinates: np.ndarray,
@@ -291,7 +285,7 @@ def _newton(
     projected = True  # far from the solution until the residual says otherwise
     step_length, tangent = 0.0, ""
     for iteration in range(ctx.max_iterations + 1):
-        evaluation = problem.evaluate(x, order=2)
+        evaluation = problem.evaluate(x, order=2, projected=method == "line-search" and projected)
         residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
         residual = float(np.linalg.norm(residual_vector))
         initial_residual = residual if initial_residual is None else initial_residual
@@ -359,12 +353,11 @@ def _newton(
             continue
 
         # globalised Newton: exact tangent first, projected where it gives no descent
-        for attempt in ("exact", "projected"):
-            if attempt == "exact" and projected:
-                continue
-            if attempt == "projected":
+        for attempt in ("projected",) if projected else ("exact", "projected"):
+            if attempt == "projected" and not projected:
                 projected = True
-                matrix = ctx.assembler.matrix(_project_psd(evaluation.hessians))
+                hessians = problem.evaluate(x, order=2, projected=True).hessians
+                matrix = ctx.assembler.matrix(hessians)
             try:
                 delta = ctx.step(matrix, -residual_vector)
             except SingularMatrixError:
@@ -565,7 +558,7 @@ def solve(
     prestress: float | Sequence[float] | np.ndarray | None = None,
     strategy: str = "auto",
     steps: int = 3,
-    initial_guess: np.ndarray | None = None,
+    initial_guess: str | np.ndarray | None = None,
     plane: PlaneSpec = None,
     tolerance: float = 1e-10,
     max_iterations: int = 50,
@@ -603,8 +596,10 @@ def solve(
     steps
         Number of equal pseudo-time steps for ``"pseudo-time"``.
     initial_guess
-        Pattern coordinates ``(n, 2)`` to start from instead of the projection. Pseudo-time
-        stepping needs the projection and is then not available.
+        ``None``/``"auto"`` (default): the projection onto ``plane``, unless no plane is named
+        and the best-fit projection folds a cell or flattens one below 0.2 of its area (slopes
+        above about 78°), then the least-squares conformal map; ``"projection"``; ``"lscm"``;
+        or pattern coordinates ``(n, 2)``. Pseudo-time stepping needs the projection.
     plane
         Plane of the projection: ``None``/``"best-fit"``, ``"xy"``, ``"yz"``, ``"zx"`` or a normal.
     tolerance
@@ -651,15 +646,31 @@ def solve(
 
     problem = make_problem(fibres)
     projection = None
-    if initial_guess is None:
+    if initial_guess is None or isinstance(initial_guess, str):
+        guess = initial_guess or "auto"
+        if guess not in INITIAL_GUESSES:
+            raise ValueError(
+                f"unknown initial guess {guess!r}; choose from {', '.join(INITIAL_GUESSES)} "
+                "or give coordinates"
+            )
+        if strategy == "pseudo-time" and guess == "lscm":
+            raise ValueError("pseudo-time stepping starts from the projection, not from LSCM")
         projection = projection_plane(mesh, plane)
-        start = projection.project(mesh.points)
+        if guess == "auto":
+            steep = projection_distortion(mesh, projection) < _PROJECTION_MIN_AREA_RATIO
+            use_lscm = plane is None and strategy != "pseudo-time" and steep
+            guess = "lscm" if use_lscm else "projection"
+        if guess == "projection":
+            start = projection.project(mesh.points)
+        else:
+            start, projection = lscm(mesh), None
     else:
         if strategy == "pseudo-time":
             raise ValueError(
                 "pseudo-time stepping starts from the projection; "
                 "drop initial_guess or choose another strategy"
             )
+        guess = "given"
         start = np.array(initial_guess, dtype=float)
         if start.shape != (mesh.num_points, 2) or not np.all(np.isfinite(start)):
             raise ValueError(
@@ -692,7 +703,9 @@ def solve(
     deviation = None
     inverted = problem.inverted_cells(start)
     if inverted.size:
-        source = "the projection onto the plane" if projection is not None else "the initial guess"
+        source = {"projection": "the projection onto the plane", "lscm": "the conformal map"}.get(
+            guess, "the initial guess"
+        )
         reason = (
             f"{source} inverts {_describe(inverted)}; choose another plane or supply an "
             "initial guess that does not fold"
@@ -762,6 +775,7 @@ def solve(
         prestress=problem.prestress,
         plane=projection,
         orientation="direction" if direction is not None else rotation,
+        initial_guess=guess,
         warp_direction=direction,
         warp_deviation=None if deviation is None else float(np.degrees(deviation)),
     )

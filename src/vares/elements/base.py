@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 
 @dataclass(frozen=True)
@@ -39,12 +40,14 @@ class ReferenceElement:
     def jacobians(self, coordinates: np.ndarray, cells: np.ndarray, at: str = "quadrature"):
         """``∂x/∂ξ`` of every cell, ``(m, q, d, 2)`` for node coordinates ``(n, d)``."""
         grads = self.shape_gradients if at == "quadrature" else self.check_gradients
-        return np.einsum("mai,qak->mqik", coordinates[cells], grads)
+        if coordinates.dtype != np.float64:  # complex-step checks take the general path
+            return np.swapaxes(coordinates[cells], 1, 2)[:, None] @ grads
+        return _jacobians(np.ascontiguousarray(coordinates), np.ascontiguousarray(cells), grads)
 
     def metrics(self, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """Surface metric ``jᵀj`` at the quadrature points, ``(m, q, 2, 2)``."""
         j = self.jacobians(points, cells)
-        return np.einsum("mqik,mqil->mqkl", j, j)
+        return np.swapaxes(j, -1, -2) @ j
 
     def areas(self, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """Area of each cell (3D or 2D coordinates), ``(m,)``."""
@@ -62,3 +65,21 @@ class ReferenceElement:
         if points.shape[1] == 2:
             return np.abs(j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0])
         return np.linalg.norm(np.cross(j[..., 0], j[..., 1]), axis=-1)
+
+
+@njit(cache=True)
+def _jacobians(coordinates, cells, grads):  # pragma: no cover - compiled
+    """``∂x/∂ξ`` ``(m, q, d, 2)`` of cells ``(m, nen)`` for node coordinates ``(n, d)``."""
+    m, nen = cells.shape
+    nq, d = grads.shape[0], coordinates.shape[1]
+    out = np.zeros((m, nq, d, 2))
+    for e in range(m):
+        for q in range(nq):
+            for a in range(nen):
+                node = cells[e, a]
+                g0, g1 = grads[q, a, 0], grads[q, a, 1]
+                for i in range(d):
+                    x = coordinates[node, i]
+                    out[e, q, i, 0] += x * g0
+                    out[e, q, i, 1] += x * g1
+    return out
