@@ -80,8 +80,11 @@ def run_method(surface: str, triangles: int, method: str, solver: str | None, ou
         import igl
 
         small = make_mesh(surface, 50)
-        igl.lscm(small.points, small.cells["triangle"].astype(np.int64),
-                 *_pins(small.points, small.cells["triangle"].astype(np.int64)))  # warm-up
+        igl.lscm(
+            small.points,
+            small.cells["triangle"].astype(np.int64),
+            *_pins(small.points, small.cells["triangle"].astype(np.int64)),
+        )  # warm-up
         start = time.perf_counter()
         pinned, values = _pins(points, faces)
         uv, _ = igl.lscm(points, faces, pinned, values)
@@ -95,9 +98,13 @@ def run_method(surface: str, triangles: int, method: str, solver: str | None, ou
             uv = igl.arap_solve(uv[fixed], data, uv)
         elif method == "slim":
             data = igl.slim_precompute(
-                np.asfortranarray(points), np.asfortranarray(faces.astype(np.int32)),
-                np.asfortranarray(uv), igl.MappingEnergyType.SYMMETRIC_DIRICHLET,
-                np.array([], dtype=np.int32), np.zeros((0, 2), order="F"), 0.0,
+                np.asfortranarray(points),
+                np.asfortranarray(faces.astype(np.int32)),
+                np.asfortranarray(uv),
+                igl.MappingEnergyType.SYMMETRIC_DIRICHLET,
+                np.array([], dtype=np.int32),
+                np.zeros((0, 2), order="F"),
+                0.0,
             )
             info["time_setup"] = time.perf_counter() - start
             uv = igl.slim_solve(data, 10)
@@ -116,8 +123,9 @@ def judge(mesh, pattern: np.ndarray) -> dict[str, float]:
     inverted = problem.inverted_cells(pattern)
     energy = float(np.sum(np.concatenate(problem.evaluate(pattern, order=0).cell_energy)))
     faces = mesh.cells["triangle"]
-    edges = np.unique(np.sort(np.vstack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]),
-                              axis=1), axis=0)
+    edges = np.unique(
+        np.sort(np.vstack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1), axis=0
+    )
     length3d = np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1)
     length2d = np.linalg.norm(pattern[edges[:, 0]] - pattern[edges[:, 1]], axis=1)
     strain = length2d / length3d - 1.0
@@ -135,8 +143,9 @@ def main() -> None:
     parser.add_argument("--surfaces", nargs="+", default=list(SURFACES), choices=SURFACES)
     parser.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
     parser.add_argument("--solver", default=None, help="vares linear solver (default: fastest)")
-    parser.add_argument("--child", nargs=4, metavar=("SURFACE", "SIZE", "METHOD", "OUT"),
-                        help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--child", nargs=4, metavar=("SURFACE", "SIZE", "METHOD", "OUT"), help=argparse.SUPPRESS
+    )
     args = parser.parse_args()
     if args.child:
         surface, size, method, out = args.child
@@ -145,12 +154,16 @@ def main() -> None:
 
     import vares
 
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python "
-          f"{platform.python_version()}, vares {vares.__version__}, linear solvers available: "
-          f"{', '.join(vares.linalg.available_solvers())}")
-    header = (f"{'surface':<7} {'triangles':>9} {'method':<6} {'time s':>8} {'setup s':>8} "
-              f"{'peak MiB':>9} {'energy':>11} {'RMS strain':>11} {'max strain':>11} "
-              f"{'inverted':>8}  notes")
+    print(
+        f"machine: {platform.machine()}, {os.cpu_count()} cores, Python "
+        f"{platform.python_version()}, vares {vares.__version__}, linear solvers available: "
+        f"{', '.join(vares.linalg.available_solvers())}"
+    )
+    header = (
+        f"{'surface':<7} {'triangles':>9} {'method':<6} {'time s':>8} {'setup s':>8} "
+        f"{'peak MiB':>9} {'energy':>11} {'RMS strain':>11} {'max strain':>11} "
+        f"{'inverted':>8}  notes"
+    )
     print(header)
     rows = []
     for surface in args.surfaces:
@@ -159,33 +172,48 @@ def main() -> None:
             for method in args.methods:
                 with tempfile.TemporaryDirectory() as tmp:
                     out = str(Path(tmp) / "pattern.npy")
-                    command = [sys.executable, __file__, "--child", surface, str(size), method,
-                               out]
+                    command = [sys.executable, __file__, "--child", surface, str(size), method, out]
                     if args.solver:
                         command += ["--solver", args.solver]
                     process = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
                     _, status, usage = os.wait4(process.pid, 0)
                     output = process.stdout.read()
                     if status != 0:
-                        print(f"{surface:<7} {mesh.num_cells:>9} {method:<6} failed (status "
-                              f"{status})")
+                        print(
+                            f"{surface:<7} {mesh.num_cells:>9} {method:<6} failed (status {status})"
+                        )
                         continue
                     info = json.loads(output.strip().splitlines()[-1])
                     quality = judge(mesh, np.load(out))
                 peak = usage.ru_maxrss / 1024
                 notes = ""
                 if method == "vares":
-                    notes = (f"{info['iterations']} iterations, {info['linear_solver']}, start "
-                             f"{info['initial_guess']}, converged {info['converged']}")
+                    notes = (
+                        f"{info['iterations']} iterations, {info['linear_solver']}, start "
+                        f"{info['initial_guess']}, converged {info['converged']}"
+                    )
                 setup = info.get("time_setup", info.get("time_initial_guess", float("nan")))
-                print(f"{surface:<7} {mesh.num_cells:>9} {method:<6} {info['time']:>8.3f} "
-                      f"{setup:>8.3f} {peak:>9.0f} {quality['energy']:>11.4e} "
-                      f"{quality['rms_edge_strain']:>11.3e} {quality['max_edge_strain']:>11.3e} "
-                      f"{quality['inverted']:>8d}  {notes}", flush=True)
-                rows.append({"surface": surface, "triangles": mesh.num_cells, "method": method,
-                             "peak_mib": peak, **info, **quality})
-    command = " ".join(["python benchmarks/flatteners.py", "--sizes",
-                        *map(str, args.sizes)] + (["--solver", args.solver] if args.solver else []))
+                print(
+                    f"{surface:<7} {mesh.num_cells:>9} {method:<6} {info['time']:>8.3f} "
+                    f"{setup:>8.3f} {peak:>9.0f} {quality['energy']:>11.4e} "
+                    f"{quality['rms_edge_strain']:>11.3e} {quality['max_edge_strain']:>11.3e} "
+                    f"{quality['inverted']:>8d}  {notes}",
+                    flush=True,
+                )
+                rows.append(
+                    {
+                        "surface": surface,
+                        "triangles": mesh.num_cells,
+                        "method": method,
+                        "peak_mib": peak,
+                        **info,
+                        **quality,
+                    }
+                )
+    command = " ".join(
+        ["python benchmarks/flatteners.py", "--sizes", *map(str, args.sizes)]
+        + (["--solver", args.solver] if args.solver else [])
+    )
     print(f"reproduce: {command}")
 
 

@@ -268,8 +268,18 @@ def test_material_option_errors(tmp_path):
 
 def test_fabric_preset_and_prestress_report(tmp_path):
     out = tmp_path / "sail"
-    result = run("example", "sail", "-o", out, "--fabric", "pes-pvc-type-2", "--prestress",
-                 "2,1.5", "--warp-direction", "1,1,0")
+    result = run(
+        "example",
+        "sail",
+        "-o",
+        out,
+        "--fabric",
+        "pes-pvc-type-2",
+        "--prestress",
+        "2,1.5",
+        "--warp-direction",
+        "1,1,0",
+    )
     assert result.exit_code == 0, result.stderr
     assert "compensation, mean" in result.stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -285,32 +295,79 @@ def test_prestress_field_option(tmp_path):
     mesh = vares.examples.four_point_sail(n=6)
     m = mesh.num_cells
     source = tmp_path / "sail.vtu"
-    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])],
-                                     cell_data={"nw": [np.full(m, 2.0)], "nf": [np.full(m, 1.5)],
-                                                "n": [np.tile([2.0, 1.5], (m, 1))]}))
+    meshio.write(
+        source,
+        meshio.Mesh(
+            mesh.points,
+            [("triangle", mesh.cells["triangle"])],
+            cell_data={
+                "nw": [np.full(m, 2.0)],
+                "nf": [np.full(m, 1.5)],
+                "n": [np.tile([2.0, 1.5], (m, 1))],
+            },
+        ),
+    )
     runs = {}
     for option in ("nw,nf", "n"):
         out = tmp_path / option.replace(",", "_")
-        result = run("pattern", source, "-o", out, "--fabric", "pes-pvc-type-2",
-                     "--prestress-field", option, "-q")
+        result = run(
+            "pattern",
+            source,
+            "-o",
+            out,
+            "--fabric",
+            "pes-pvc-type-2",
+            "--prestress-field",
+            option,
+            "-q",
+        )
         assert result.exit_code == 0, result.stderr
         runs[option] = json.loads((out / "summary.json").read_text())
     uniform = tmp_path / "uniform"
-    assert run("pattern", source, "-o", uniform, "--fabric", "pes-pvc-type-2", "--prestress",
-               "2,1.5", "-q").exit_code == 0
+    assert (
+        run(
+            "pattern",
+            source,
+            "-o",
+            uniform,
+            "--fabric",
+            "pes-pvc-type-2",
+            "--prestress",
+            "2,1.5",
+            "-q",
+        ).exit_code
+        == 0
+    )
     expected = json.loads((uniform / "summary.json").read_text())["energy"]
     assert runs["n"]["energy"] == pytest.approx(expected, rel=1e-9)
     assert runs["nw,nf"]["energy"] == pytest.approx(expected, rel=1e-9)
-    result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "pes-pvc-type-2",
-                 "--prestress-field", "sigma")
+    result = run(
+        "pattern",
+        source,
+        "-o",
+        tmp_path / "x",
+        "--fabric",
+        "pes-pvc-type-2",
+        "--prestress-field",
+        "sigma",
+    )
     assert result.exit_code == 2 and "no cell data" in error_line(result)
-    result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "pes-pvc-type-2",
-                 "--prestress", "2", "--prestress-field", "n")
+    result = run(
+        "pattern",
+        source,
+        "-o",
+        tmp_path / "x",
+        "--fabric",
+        "pes-pvc-type-2",
+        "--prestress",
+        "2",
+        "--prestress-field",
+        "n",
+    )
     assert result.exit_code == 2 and "not both" in error_line(result)
     result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "mystery")
     assert result.exit_code == 2 and "unknown fabric preset" in error_line(result)
-    result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "pes-pvc-type-2",
-                 "--E1", 5)
+    result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "pes-pvc-type-2", "--E1", 5)
     assert result.exit_code == 2 and "--fabric sets the material" in error_line(result)
 
 

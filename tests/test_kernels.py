@@ -91,7 +91,10 @@ def test_gradient_is_the_eshelby_material_force(cell_type):
 def test_global_residual_and_tangent_by_finite_differences(mixed_mesh):
     """Assembled over a mixed triangle/quad mesh with fixed dofs, against central differences."""
     problem = Problem(
-        mixed_mesh, NeoHooke(E=5.0, nu=0.3), 0.9, fibres=Fibres.from_angles(20.0),
+        mixed_mesh,
+        NeoHooke(E=5.0, nu=0.3),
+        0.9,
+        fibres=Fibres.from_angles(20.0),
         prestress=(0.4, 0.25, 0.1),
     )
     rng = np.random.default_rng(3)

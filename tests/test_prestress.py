@@ -62,8 +62,10 @@ def homogeneous_stretches(psi, p1, p2, t):
     [
         (StVenantKirchhoff(600.0, 0.3), lambda a, b: psi_svk(a, b, 600.0, 0.3)),
         (NeoHooke(600.0, 0.45), lambda a, b: psi_neo_hooke(a, b, 600.0, 0.45)),
-        (OrthotropicStVenantKirchhoff(800.0, 500.0, 30.0, 0.35),
-         lambda a, b: psi_ortho(a, b, 800.0, 500.0, 0.35)),
+        (
+            OrthotropicStVenantKirchhoff(800.0, 500.0, 30.0, 0.35),
+            lambda a, b: psi_ortho(a, b, 800.0, 500.0, 0.35),
+        ),
     ],
     ids=["svk", "neo-hooke", "orthotropic"],
 )
@@ -98,10 +100,12 @@ def test_prestressed_flat_rectangle_matches_the_closed_form(material, psi, thick
 
 def test_prestress_residual_and_tangent_by_finite_differences(mixed_mesh):
     rng = np.random.default_rng(8)
-    per_cell = np.column_stack([rng.uniform(1, 3, 8), rng.uniform(0.5, 2, 8),
-                                rng.uniform(-0.3, 0.3, 8)])
-    problem = vares.Problem(mixed_mesh, NeoHooke(50.0, 0.3), 0.7,
-                            fibres=Fibres.from_angles(-15.0), prestress=per_cell)
+    per_cell = np.column_stack(
+        [rng.uniform(1, 3, 8), rng.uniform(0.5, 2, 8), rng.uniform(-0.3, 0.3, 8)]
+    )
+    problem = vares.Problem(
+        mixed_mesh, NeoHooke(50.0, 0.3), 0.7, fibres=Fibres.from_angles(-15.0), prestress=per_cell
+    )
     pattern = mixed_mesh.points[:, :2] * [0.97, 1.02] + 0.01 * rng.normal(size=(12, 2))
     free = np.ones(24, bool)
     assembler = Assembler(mixed_mesh, free)
@@ -115,8 +119,10 @@ def test_prestress_residual_and_tangent_by_finite_differences(mixed_mesh):
         down.ravel()[dof] -= h
         fd = (problem.energy(up) - problem.energy(down)) / (2 * h)
         assert gradient[dof] == pytest.approx(fd, abs=1e-7)
-        column = (assembler.vector(problem.evaluate(up).gradients).ravel()
-                  - assembler.vector(problem.evaluate(down).gradients).ravel()) / (2 * h)
+        column = (
+            assembler.vector(problem.evaluate(up).gradients).ravel()
+            - assembler.vector(problem.evaluate(down).gradients).ravel()
+        ) / (2 * h)
         np.testing.assert_allclose(matrix[:, dof], column, atol=1e-6)
     # the prestress term is really there: without it the gradient differs
     bare = vares.Problem(mixed_mesh, NeoHooke(50.0, 0.3), 0.7, fibres=Fibres.from_angles(-15.0))
@@ -132,8 +138,7 @@ def test_prestress_is_ramped_with_pseudo_time():
     stepped = vares.solve(mesh, material, prestress=(2.0, 1.5), strategy="pseudo-time", steps=4)
     direct = vares.solve(mesh, material, prestress=(2.0, 1.5))
     assert stepped.converged and direct.converged
-    np.testing.assert_allclose(stepped.material_coordinates, direct.material_coordinates,
-                               atol=1e-9)
+    np.testing.assert_allclose(stepped.material_coordinates, direct.material_coordinates, atol=1e-9)
 
 
 def test_sail_pattern_with_prestress_is_compensated():
@@ -159,8 +164,9 @@ def test_conic_tent_panel():
     mesh = conic_tent()
     assert mesh.points[:, 2].max() == pytest.approx(6.0)
     assert mesh.points[:, 2].min() == pytest.approx(0.0, abs=1e-12)
-    result = vares.solve(mesh, fabric("pes-pvc-type-1").material(), warp_direction=(1, 0, 0),
-                         prestress=(2.0, 1.5))
+    result = vares.solve(
+        mesh, fabric("pes-pvc-type-1").material(), warp_direction=(1, 0, 0), prestress=(2.0, 1.5)
+    )
     assert result.converged, result.reason
     report = compensation_report(result)
     assert report.warp.compensation_mean > 0 and report.fill.compensation_mean > 0
@@ -194,8 +200,14 @@ def test_prestress_field_from_cell_data(tmp_path):
     mesh = four_point_sail(n=6)
     field = np.column_stack([np.linspace(1.5, 2.5, mesh.num_cells), np.full(mesh.num_cells, 1.5)])
     path = tmp_path / "sail.vtu"
-    meshio.write(path, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])],
-                                   cell_data={"n": [field], "n_warp": [field[:, 0]]}))
+    meshio.write(
+        path,
+        meshio.Mesh(
+            mesh.points,
+            [("triangle", mesh.cells["triangle"])],
+            cell_data={"n": [field], "n_warp": [field[:, 0]]},
+        ),
+    )
     read, data = vares.read_mesh_data(path)
     np.testing.assert_allclose(data["n"], field)
     material = fabric("pes-pvc-type-2").material()
@@ -207,8 +219,13 @@ def test_prestress_field_from_cell_data(tmp_path):
 
 def test_shipped_presets_say_where_their_numbers_come_from():
     catalogue = presets()
-    assert {"pes-pvc-type-1", "pes-pvc-type-2", "pes-pvc-type-3", "pes-pvc-type-4",
-            "glass-ptfe"} <= set(catalogue)
+    assert {
+        "pes-pvc-type-1",
+        "pes-pvc-type-2",
+        "pes-pvc-type-3",
+        "pes-pvc-type-4",
+        "glass-ptfe",
+    } <= set(catalogue)
     for preset in catalogue.values():
         assert "typical value" in preset.source
         material = preset.material()
@@ -217,15 +234,17 @@ def test_shipped_presets_say_where_their_numbers_come_from():
 
 def test_user_presets(tmp_path):
     path = tmp_path / "mine.toml"
-    path.write_text('[roll-4711]\ndescription = "tested"\nE1 = 780\nE2 = 590\nG12 = 25\n'
-                    'nu12 = 0.38\nsource = "our biaxial test"\n')
+    path.write_text(
+        '[roll-4711]\ndescription = "tested"\nE1 = 780\nE2 = 590\nG12 = 25\n'
+        'nu12 = 0.38\nsource = "our biaxial test"\n'
+    )
     assert load_presets(path)["roll-4711"].material().E2 == 590.0
     assert fabric("roll-4711", path).nu12 == 0.38
     assert fabric("glass-ptfe", path).E1 == 1400.0
     bad = tmp_path / "bad.toml"
     for text, message in [
         ("[x]\nE1 = 1\nE2 = 1\nG12 = 1\n", "lacks nu12"),
-        ('[x]\nE1 = 1\nE2 = 1\nG12 = 1\nnu12 = 0.3\n', "where its numbers come from"),
+        ("[x]\nE1 = 1\nE2 = 1\nG12 = 1\nnu12 = 0.3\n", "where its numbers come from"),
         ('[x]\nE1 = 1\nE2 = 100\nG12 = 1\nnu12 = 0.3\nsource = "s"\n', "positive definite"),
         ('[x]\nE1 = 1\nE2 = 1\nG12 = 1\nnu12 = 0.3\nsource = "s"\ncolour = 2\n', "unknown keys"),
         ("[x\n", "not valid TOML"),

@@ -38,9 +38,12 @@ def test_robustness_suite_converges_with_the_default_strategy(name, law):
     assert result.converged, result.reason
     assert result.strategy[0] == "globalised newton"
     assert result.history[-1].relative_residual <= 1e-10
-    assert vares.Problem(mesh, law, fibres=result.fibres).inverted_cells(
-        result.material_coordinates
-    ).size == 0
+    assert (
+        vares.Problem(mesh, law, fibres=result.fibres)
+        .inverted_cells(result.material_coordinates)
+        .size
+        == 0
+    )
 
 
 @pytest.mark.parametrize("name", ["hemisphere", "deep cap 120°", "cylinder 220°"])
@@ -73,8 +76,11 @@ def test_globalised_newton_ends_quadratically():
     result = vares.solve(mesh, NEO_HOOKE, tolerance=1e-14)
     records = [r for r in result.history if r.strategy == "globalised newton"]
     residuals = [r.relative_residual for r in records]
-    tail = [(a, b, c) for a, b, c in zip(residuals, residuals[1:], residuals[2:], strict=False)
-            if b < 1e-3 and c > 1e-13]
+    tail = [
+        (a, b, c)
+        for a, b, c in zip(residuals, residuals[1:], residuals[2:], strict=False)
+        if b < 1e-3 and c > 1e-13
+    ]
     assert tail, residuals
     orders = [np.log(c / b) / np.log(b / a) for a, b, c in tail]
     assert min(orders) > 1.8, (orders, residuals)
@@ -94,8 +100,13 @@ def test_no_inverted_pattern_is_ever_accepted(monkeypatch):
     monkeypatch.setattr(vares.Problem, "evaluate", checking)
     mesh = examples.cylinder160(n_around=16, n_along=6)
     for strategy in ("auto", "damping", "pseudo-time"):
-        result = vares.solve(mesh, NonCrimpFabric.from_moduli(1000.0, 1000.0, 5.0),
-                             warp_angle=30.0, strategy=strategy, plane="xy")
+        result = vares.solve(
+            mesh,
+            NonCrimpFabric.from_moduli(1000.0, 1000.0, 5.0),
+            warp_angle=30.0,
+            strategy=strategy,
+            plane="xy",
+        )
         assert result.converged, (strategy, result.reason)
     assert len(seen) > 20 and max(seen) == 0
 
@@ -153,8 +164,9 @@ def test_every_linear_solver_gives_the_same_pattern(name):
     reference = vares.solve(mesh, ORTHO, warp_angle=20.0, linear_solver="scipy-superlu")
     result = vares.solve(mesh, ORTHO, warp_angle=20.0, linear_solver=name)
     assert result.linear_solver == name and result.converged
-    np.testing.assert_allclose(result.material_coordinates, reference.material_coordinates,
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        result.material_coordinates, reference.material_coordinates, atol=1e-9
+    )
 
 
 def test_singular_matrices_are_reported():
