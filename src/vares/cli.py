@@ -1,16 +1,15 @@
-"""Command line: ``vares pattern``, ``vares example``, ``vares evaluate``.
+"""Command line: ``vares pattern``, ``example``, ``run``, ``evaluate``, ``fabrics``.
 
-A thin layer over the Python API: it parses options, shows progress, writes files and turns
-every error into a one-line message and a non-zero exit status (2: bad input or options,
-1: the solve did not converge, 3: unexpected internal error).
+A thin layer over the Python API: options become a :class:`vares.job.Job`, which
+:func:`vares.runner.run_job` runs. Progress goes to the terminal; every error becomes one line
+``vares: error: …`` and an exit status (2: bad input or options, 1: the solve did not converge,
+3: unexpected internal error), never a traceback.
 """
 
-from __future__ import annotations
-
-from dataclasses import dataclass
+import inspect
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import numpy as np
 import typer
@@ -19,20 +18,20 @@ from rich.table import Table
 
 from . import examples as example_surfaces
 from .analysis import evaluate as evaluate_pattern
-from .compensation import compensation_report
 from .io import (
     OutputExistsError,
+    atomic_path,
     check_writable,
     field_statistics,
     read_pattern,
-    summary,
     write_json,
     write_surface,
 )
-from .materials import LAWS, Hyperelastic, MaterialError, load_presets, make_material, presets
-from .materials import fabric as fabric_preset
-from .mesh import MeshError, SurfaceMesh, read_mesh_data
-from .solver import IterationRecord, PatternResult, solve
+from .job import Job, JobError, load_job
+from .materials import LAWS, MaterialError, load_presets, presets
+from .mesh import MeshError, read_mesh
+from .runner import JobOutcome, build_material, run_job
+from .solver import STRATEGIES, IterationRecord
 
 app = typer.Typer(
     help="Cutting patterns of doubly curved membranes by the Variation of Reference Strategy.",
@@ -43,201 +42,181 @@ app = typer.Typer(
 console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 Law = StrEnum("Law", {name: name for name in LAWS})
-
-
-class Strategy(StrEnum):
-    auto = "auto"
-    newton = "newton"
-    pseudo_time = "pseudo-time"
-    damping = "damping"
-
-
-class Orientation(StrEnum):
-    held = "held"
-    free = "free"
-
-
-class CellType(StrEnum):
-    triangle = "triangle"
-    quad = "quad"
+Strategy = StrEnum("Strategy", {name: name for name in STRATEGIES})
+Orientation = StrEnum("Orientation", {"held": "held", "free": "free"})
+CellType = StrEnum("CellType", {"triangle": "triangle", "quad": "quad"})
+Units = StrEnum("Units", {"mm": "mm", "cm": "cm", "m": "m"})
 
 
 class InputError(Exception):
     """Bad input or options (exit status 2)."""
 
 
-# ---------------------------------------------------------------------------- options
-def _opt(*names: str, help: str, **kwargs) -> typer.models.OptionInfo:
-    return typer.Option(*names, help=help, **kwargs)
+# ---------------------------------------------------------------------------- shared options
+def _option(
+    default: Any, kind: Any, *names: str, help: str, panel: str, **extra
+) -> inspect.Parameter:
+    name = names[0].lstrip("-").replace("-", "_")
+    option = typer.Option(*names, help=help, rich_help_panel=panel, **extra)
+    return inspect.Parameter(
+        name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=Annotated[kind, option]
+    )
 
 
-MaterialOption = Annotated[
-    Law,
-    _opt(
+_M, _F, _P, _S, _O = "Material", "Fibres", "Prestress", "Solver", "Output"
+SOLVE_OPTIONS = [
+    _option(
+        Law["neo-hooke"],
+        Law,
         "--material",
         "-m",
         help="Hyperelastic law.",
+        panel=_M,
         case_sensitive=False,
-        rich_help_panel="Material",
     ),
-]
-_PANEL = {"rich_help_panel": "Material"}
-YoungOption = Annotated[
-    float | None,
-    _opt(
+    _option(
+        None,
+        float | None,
         "--E",
         "-E",
-        help="Young's modulus (neo-hooke, st-venant-kirchhoff; default 1000). "
-        "Without prestress only the stresses scale with it, not the pattern.",
-        **_PANEL,
+        help="Young's modulus (neo-hooke, st-venant-kirchhoff; default 1000).",
+        panel=_M,
     ),
-]
-PoissonOption = Annotated[
-    float | None, _opt("--nu", help="Poisson's ratio, -1 < nu <= 0.5 (default 0.3).", **_PANEL)
-]
-ShearOption = Annotated[
-    float | None, _opt("--mu", help="Shear modulus (incompressible-neo-hooke).", **_PANEL)
-]
-E1Option = Annotated[float | None, _opt("--E1", help="Warp modulus (orthotropic).", **_PANEL)]
-E2Option = Annotated[float | None, _opt("--E2", help="Fill modulus (orthotropic).", **_PANEL)]
-G12Option = Annotated[
-    float | None, _opt("--G12", help="In-plane shear modulus (orthotropic).", **_PANEL)
-]
-Nu12Option = Annotated[
-    float | None, _opt("--nu12", help="Poisson's ratio warp→fill (orthotropic).", **_PANEL)
-]
-AOption = Annotated[
-    str | None, _opt("--A", help="NCF warp coefficients 'A0,A1,…' (sum 0).", **_PANEL)
-]
-BOption = Annotated[
-    str | None, _opt("--B", help="NCF fill coefficients 'B0,B1,…' (sum 0).", **_PANEL)
-]
-COption = Annotated[str | None, _opt("--C", help="NCF shear coefficients 'C1,C2,…'.", **_PANEL)]
-ThicknessOption = Annotated[
-    float, _opt("--thickness", "-t", help="Thickness; 1 for laws given as force/length.", **_PANEL)
-]
-FabricOption = Annotated[
-    str | None,
-    _opt("--fabric", help="Fabric preset (see 'vares fabrics'); replaces --material.", **_PANEL),
-]
-PresetsOption = Annotated[
-    Path | None, _opt("--presets", help="TOML file with your own fabric presets.", **_PANEL)
-]
-_PRESTRESS = {"rich_help_panel": "Prestress"}
-PrestressOption = Annotated[
-    str | None,
-    _opt(
-        "--prestress",
-        help="Prestress along the yarns, force/length: 'WARP,FILL' or one value for both.",
-        **_PRESTRESS,
+    _option(
+        None, float | None, "--nu", help="Poisson's ratio, -1 < nu <= 0.5 (default 0.3).", panel=_M
     ),
-]
-PrestressFieldOption = Annotated[
-    str | None,
-    _opt(
-        "--prestress-field",
-        help="Per-cell prestress from the input's cell data: 'NAME' "
-        "(columns warp, fill[, shear]) or 'WARP_NAME,FILL_NAME'.",
-        **_PRESTRESS,
+    _option(None, float | None, "--mu", help="Shear modulus (incompressible-neo-hooke).", panel=_M),
+    _option(None, float | None, "--E1", help="Warp modulus (orthotropic).", panel=_M),
+    _option(None, float | None, "--E2", help="Fill modulus (orthotropic).", panel=_M),
+    _option(None, float | None, "--G12", help="In-plane shear modulus (orthotropic).", panel=_M),
+    _option(
+        None, float | None, "--nu12", help="Poisson's ratio warp→fill (orthotropic).", panel=_M
     ),
-]
-SlackOption = Annotated[
-    float,
-    _opt(
-        "--slack-threshold",
-        help="Report cells whose achieved yarn force is below this (force/length).",
-        **_PRESTRESS,
+    _option(None, str | None, "--A", help="NCF warp coefficients 'A0,A1,…' (sum 0).", panel=_M),
+    _option(None, str | None, "--B", help="NCF fill coefficients 'B0,B1,…' (sum 0).", panel=_M),
+    _option(None, str | None, "--C", help="NCF shear coefficients 'C1,C2,…'.", panel=_M),
+    _option(
+        None,
+        str | None,
+        "--fabric",
+        help="Fabric preset (see 'vares fabrics'); replaces --material.",
+        panel=_M,
     ),
-]
-_FIBRES = {"rich_help_panel": "Fibres"}
-WarpAngleOption = Annotated[
-    float, _opt("--warp-angle", help="Warp angle in the pattern frame, degrees.", **_FIBRES)
-]
-FillAngleOption = Annotated[
-    float | None,
-    _opt("--fill-angle", help="Fill angle in the pattern frame (default warp + 90).", **_FIBRES),
-]
-WarpDirectionOption = Annotated[
-    str | None,
-    _opt(
+    _option(
+        None, Path | None, "--presets", help="TOML file with your own fabric presets.", panel=_M
+    ),
+    _option(
+        1.0,
+        float,
+        "--thickness",
+        "-t",
+        help="Thickness; 1 for laws given as force/length.",
+        panel=_M,
+    ),
+    _option(0.0, float, "--warp-angle", help="Warp angle in the pattern frame, degrees.", panel=_F),
+    _option(None, float | None, "--fill-angle", help="Fill angle (default warp + 90).", panel=_F),
+    _option(
+        None,
+        str | None,
         "--warp-direction",
         help="3D direction 'x,y,z' the warp follows on the surface (overrides --warp-angle).",
-        **_FIBRES,
+        panel=_F,
     ),
-]
-OrientationOption = Annotated[
-    Orientation,
-    _opt(
+    _option(
+        Orientation.held,
+        Orientation,
         "--orientation",
-        help="Anisotropic laws: keep the initial guess's rotation (held) "
-        "or let the energy choose it (free).",
+        help="Anisotropic: keep the initial "
+        "guess's rotation (held) or let the energy choose it (free).",
+        panel=_F,
         case_sensitive=False,
-        **_FIBRES,
     ),
+    _option(
+        None,
+        str | None,
+        "--prestress",
+        help="Prestress along the yarns, force/length: 'WARP,FILL' or one value for both.",
+        panel=_P,
+    ),
+    _option(
+        None,
+        str | None,
+        "--prestress-field",
+        help="Per-cell prestress from the input's "
+        "cell data: 'NAME' (columns warp, fill[, shear]) or 'WARP_NAME,FILL_NAME'.",
+        panel=_P,
+    ),
+    _option(
+        0.0,
+        float,
+        "--slack-threshold",
+        help="Report cells whose achieved yarn force is below this (force/length).",
+        panel=_P,
+    ),
+    _option(
+        Strategy.auto,
+        Strategy,
+        "--strategy",
+        "-s",
+        help="Solution strategy.",
+        panel=_S,
+        case_sensitive=False,
+    ),
+    _option(3, int, "--steps", help="Pseudo-time steps (pseudo-time).", panel=_S),
+    _option(
+        None,
+        str | None,
+        "--plane",
+        help="Initial-guess plane: best-fit, xy, yz, zx, or a "
+        "normal 'nx,ny,nz' (default: best-fit; an example's own).",
+        panel=_S,
+    ),
+    _option(1e-10, float, "--tolerance", help="Relative residual tolerance.", panel=_S),
+    _option(50, int, "--max-iterations", help="Newton iterations per step.", panel=_S),
+    _option(
+        None,
+        str | None,
+        "--linear-solver",
+        help="pardiso, cholmod or scipy-superlu (default: the fastest installed).",
+        panel=_S,
+    ),
+    _option(Path("vares-out"), Path, "--output", "-o", help="Output directory.", panel=_O),
+    _option(False, bool, "--report", help="Also write report.html.", panel=_O),
+    _option(Units.m, Units, "--units", help="Units of the mesh coordinates.", panel=_O),
+    _option(Units.mm, Units, "--dxf-units", help="Units of the DXF drawing.", panel=_O),
+    _option(
+        0.0, float, "--allowance", help="Seam allowance for the DXF cut line (DXF units).", panel=_O
+    ),
+    _option(
+        None,
+        float | None,
+        "--mark-spacing",
+        help="Match mark spacing along the seam line (DXF units).",
+        panel=_O,
+    ),
+    _option(None, str | None, "--name", help="Panel name for drawings and report.", panel=_O),
+    _option(
+        None,
+        Path | None,
+        "--save-job",
+        help="Write the job as TOML (rerun with 'vares run').",
+        panel=_O,
+    ),
+    _option(False, bool, "--force", "-f", help="Overwrite existing output files.", panel=_O),
+    _option(False, bool, "--quiet", "-q", help="Show no progress.", panel=_O),
 ]
-_SOLVER = {"rich_help_panel": "Solver"}
-StrategyOption = Annotated[
-    Strategy,
-    _opt("--strategy", "-s", help="Solution strategy.", case_sensitive=False, **_SOLVER),
-]
-StepsOption = Annotated[int, _opt("--steps", help="Pseudo-time steps (pseudo-time).", **_SOLVER)]
-ToleranceOption = Annotated[
-    float, _opt("--tolerance", help="Relative residual tolerance.", **_SOLVER)
-]
-MaxIterationsOption = Annotated[
-    int, _opt("--max-iterations", help="Newton iterations per step.", **_SOLVER)
-]
-ForceOption = Annotated[bool, _opt("--force", "-f", help="Overwrite existing output files.")]
-QuietOption = Annotated[bool, _opt("--quiet", "-q", help="Show no progress.")]
-OutOption = Annotated[Path, _opt("--output", "-o", help="Output directory.")]
 
 
-@dataclass
-class MaterialOptions:
-    law: Law
-    E: float | None
-    nu: float | None
-    mu: float | None
-    E1: float | None
-    E2: float | None
-    G12: float | None
-    nu12: float | None
-    A: str | None
-    B: str | None
-    C: str | None
+def _with_options(parameters: list[inspect.Parameter]):
+    """Give a ``**options`` command the shared option parameters (one definition for all)."""
 
-    fabric: str | None = None
-    presets: Path | None = None
+    def decorate(func):
+        signature = inspect.signature(func)
+        own = [p for p in signature.parameters.values() if p.kind != p.VAR_KEYWORD]
+        func.__signature__ = signature.replace(parameters=own + parameters)
+        return func
 
-    def build(self) -> Hyperelastic:
-        if self.fabric is not None:
-            given = [
-                n
-                for n in ("E", "nu", "mu", "E1", "E2", "G12", "nu12", "A", "B", "C")
-                if getattr(self, n) is not None
-            ]
-            if given or str(self.law) != "neo-hooke":
-                raise InputError("--fabric sets the material; drop --material and its parameters")
-            return fabric_preset(self.fabric, self.presets).material()
-        if self.presets is not None:
-            raise InputError("--presets needs --fabric")
-        law = str(self.law)
-        given = {
-            "E": self.E,
-            "nu": self.nu,
-            "mu": self.mu,
-            "E1": self.E1,
-            "E2": self.E2,
-            "G12": self.G12,
-            "nu12": self.nu12,
-            "A": _numbers("--A", self.A),
-            "B": _numbers("--B", self.B),
-            "C": _numbers("--C", self.C),
-        }
-        given = {name: value for name, value in given.items() if value is not None}
-        if law in ("neo-hooke", "st-venant-kirchhoff"):
-            given = {"E": 1000.0, "nu": 0.3} | given
-        return make_material(law, given)
+    return decorate
 
 
 def _numbers(option: str, text: str | None) -> list[float] | None:
@@ -249,44 +228,78 @@ def _numbers(option: str, text: str | None) -> list[float] | None:
         raise InputError(f"{option}: cannot read numbers from {text!r}") from exc
 
 
-def _vector(option: str, text: str) -> np.ndarray:
+def _vector(option: str, text: str) -> list[float]:
     values = _numbers(option, text)
     if len(values) != 3:
         raise InputError(f"{option}: expected three numbers 'x,y,z'; got {text!r}")
-    return np.array(values)
+    return values
 
 
-def _prestress(
-    text: str | None, field: str | None, cell_data: dict[str, np.ndarray] | None
-) -> np.ndarray | None:
-    if text is not None and field is not None:
+def job_from_options(source: dict[str, Any], o: dict[str, Any]) -> Job:
+    """The job the command line describes."""
+    material: dict[str, Any] = {"thickness": o["thickness"]}
+    parameters = {k: o[k] for k in ("E", "nu", "mu", "E1", "E2", "G12", "nu12") if o[k] is not None}
+    for key in ("A", "B", "C"):
+        if o[key] is not None:
+            parameters[key] = _numbers(f"--{key}", o[key])
+    if o["fabric"] is not None:
+        if parameters or str(o["material"]) != "neo-hooke":
+            raise InputError("--fabric sets the material; drop --material and its parameters")
+        material["fabric"] = o["fabric"]
+        if o["presets"] is not None:
+            material["presets"] = str(o["presets"].resolve())
+    else:
+        if o["presets"] is not None:
+            raise InputError("--presets needs --fabric")
+        material["law"] = str(o["material"])
+        material.update(parameters)
+    fibres: dict[str, Any] = {"warp_angle": o["warp_angle"], "orientation": str(o["orientation"])}
+    if o["fill_angle"] is not None:
+        fibres["fill_angle"] = o["fill_angle"]
+    if o["warp_direction"] is not None:
+        fibres["warp_direction"] = _vector("--warp-direction", o["warp_direction"])
+    prestress: dict[str, Any] = {"slack_threshold": o["slack_threshold"]}
+    if o["prestress"] is not None and o["prestress_field"] is not None:
         raise InputError("give --prestress or --prestress-field, not both")
-    if text is not None:
-        values = _numbers("--prestress", text)
+    if o["prestress"] is not None:
+        values = _numbers("--prestress", o["prestress"])
         if len(values) not in (1, 2, 3):
-            raise InputError(f"--prestress: expected 'WARP,FILL' or one value; got {text!r}")
-        return np.array(values[0] if len(values) == 1 else values)
-    if field is None:
-        return None
-    if cell_data is None:
-        raise InputError("--prestress-field needs an input file with cell data")
-    names = field.split(",")
-    missing = [n for n in names if n not in cell_data]
-    if missing or len(names) > 3:
-        known = ", ".join(cell_data) or "none"
-        raise InputError(
-            f"--prestress-field: no cell data {', '.join(missing) or field!r} "
-            f"in the input (it has: {known})"
-        )
-    if len(names) == 1:
-        return cell_data[names[0]]
-    return np.column_stack([np.asarray(cell_data[n], dtype=float).ravel() for n in names])
+            raise InputError(
+                f"--prestress: expected 'WARP,FILL' or one value; got {o['prestress']!r}"
+            )
+        prestress["warp"], prestress["fill"] = values[0], values[1 if len(values) > 1 else 0]
+        if len(values) == 3:
+            prestress["shear"] = values[2]
+    if o["prestress_field"] is not None:
+        names = o["prestress_field"].split(",")
+        prestress["field"] = names[0] if len(names) == 1 else names
+    solver: dict[str, Any] = {
+        "strategy": str(o["strategy"]),
+        "steps": o["steps"],
+        "tolerance": o["tolerance"],
+        "max_iterations": o["max_iterations"],
+    }
+    if o["plane"] is not None:
+        solver["plane"] = _vector("--plane", o["plane"]) if "," in o["plane"] else o["plane"]
+    if o["linear_solver"] is not None:
+        solver["linear_solver"] = o["linear_solver"]
+    output: dict[str, Any] = {
+        "directory": str(o["output"].resolve()),
+        "report": o["report"],
+        "dxf_units": str(o["dxf_units"]),
+        "allowance": o["allowance"],
+    }
+    if o["mark_spacing"] is not None:
+        output["mark_spacing"] = o["mark_spacing"]
+    input_ = {**source, "units": str(o["units"])}
+    if o["name"] is not None:
+        input_["name"] = o["name"]
+    job = Job(input_, material, fibres, prestress, solver, output, base=Path.cwd())
+    job.check("command line")
+    return job
 
 
-def _plane(text: str):
-    return _vector("--plane", text) if "," in text else text
-
-
+# ---------------------------------------------------------------------------- presentation
 def _progress(quiet: bool):
     if quiet:
         return None
@@ -318,9 +331,8 @@ def _field_table(fields: dict[str, np.ndarray]) -> Table:
     table = Table("field", "min", "mean", "max", title="per-cell results (mean: area-weighted)")
     statistics = field_statistics(fields)
     for name in _TABLE_FIELDS:
-        if name in statistics:
-            s = statistics[name]
-            table.add_row(name, f"{s['min']:.6g}", f"{s['mean']:.6g}", f"{s['max']:.6g}")
+        s = statistics[name]
+        table.add_row(name, f"{s['min']:.6g}", f"{s['mean']:.6g}", f"{s['max']:.6g}")
     return table
 
 
@@ -331,7 +343,6 @@ def _compensation_table(report) -> Table:
         "fill",
         title="compensation and prestress (force per length; means area-weighted)",
     )
-    w, f = report.warp, report.fill
     rows = [
         ("compensation, mean", lambda y: f"{y.compensation_mean:.3f} %"),
         (
@@ -348,11 +359,12 @@ def _compensation_table(report) -> Table:
         ),
     ]
     for label, cell in rows:
-        table.add_row(label, cell(w), cell(f))
+        table.add_row(label, cell(report.warp), cell(report.fill))
     return table
 
 
-def _report(result: PatternResult, outputs: list[Path], report=None) -> None:
+def _show(outcome: JobOutcome) -> None:
+    result = outcome.result
     status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
     console.print(
         f"{status} in {result.iterations} iterations ({' → '.join(result.strategy)}), "
@@ -361,13 +373,15 @@ def _report(result: PatternResult, outputs: list[Path], report=None) -> None:
     )
     if result.converged:
         console.print(_field_table(result.fields))
-        if report is not None:
-            console.print(_compensation_table(report))
+        if result.prestress is not None and outcome.compensation is not None:
+            console.print(_compensation_table(outcome.compensation))
         if result.warp_deviation is not None:
             console.print(
                 f"mean deviation of the warp from the direction: {result.warp_deviation:.2e}°"
             )
-    for path in outputs:
+    for warning in outcome.warnings:
+        console.print(f"[yellow]warning:[/] {warning}")
+    for path in outcome.files:
         console.print(f"  wrote {path}")
 
 
@@ -386,6 +400,7 @@ def _guarded(func):
         MeshError,
         MaterialError,
         InputError,
+        JobError,
         OutputExistsError,
         FileNotFoundError,
         ValueError,
@@ -399,285 +414,195 @@ def _guarded(func):
         raise typer.Exit(_fail(f"internal error: {type(exc).__name__}: {exc}", 3)) from None
 
 
-def _solve_and_write(
-    mesh: SurfaceMesh,
-    outdir: Path,
-    material: Hyperelastic,
-    *,
-    input_name: str,
-    write_input: bool,
-    thickness: float,
-    warp_angle: float,
-    fill_angle: float | None,
-    warp_direction: str | None,
-    orientation: Orientation,
-    prestress: np.ndarray | None,
-    slack_threshold: float,
-    strategy: Strategy,
-    steps: int,
-    plane: str,
-    tolerance: float,
-    max_iterations: int,
-    force: bool,
-    quiet: bool,
-) -> None:
-    direction = None if warp_direction is None else _vector("--warp-direction", warp_direction)
-    paths = {
-        "pattern": outdir / "pattern.obj",
-        "pattern_vtu": outdir / "pattern.vtu",
-        "surface_vtu": outdir / "surface.vtu",
-        "summary": outdir / "summary.json",
-    }
-    if write_input:
-        paths["surface"] = outdir / "surface.obj"
-    check_writable(paths.values(), force)
+def _execute(job: Job, *, force: bool, quiet: bool, save_job: Path | None = None) -> None:
+    if save_job is not None:
+        check_writable([save_job], force)
+
+    def starting(name, mesh, material) -> None:
+        if not quiet:
+            console.print(
+                f"{name}: {mesh}; {material!r}, thickness {job.material.get('thickness', 1.0):g}"
+            )
+
+    outcome = run_job(job, force=force, callback=_progress(quiet), on_solve_start=starting)
+    if save_job is not None:
+        with atomic_path(save_job) as temporary:
+            temporary.write_text(job.to_toml(), encoding="utf-8")
+        outcome.files.append(save_job)
     if not quiet:
-        console.print(f"{input_name}: {mesh}; {material!r}, thickness {thickness:g}")
-    result = solve(
-        mesh,
-        material,
-        thickness,
-        warp_angle=warp_angle,
-        fill_angle=fill_angle,
-        warp_direction=direction,
-        orientation=str(orientation),
-        prestress=prestress,
-        strategy=str(strategy),
-        steps=steps,
-        plane=_plane(plane),
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        callback=_progress(quiet),
-    )
-    written = []
-    if write_input:
-        write_surface(paths["surface"], mesh)
-        written.append(paths["surface"])
-    data = summary(result, input=input_name, tolerance=tolerance)
-    report = None
-    if result.converged:
-        report = compensation_report(result, slack_threshold)
-        data["compensation"] = report.to_dict()
-        write_surface(paths["pattern"], mesh, result.material_coordinates)
-        write_surface(paths["pattern_vtu"], mesh, result.material_coordinates, result.fields)
-        write_surface(paths["surface_vtu"], mesh, fields=result.fields)
-        written += [paths["pattern"], paths["pattern_vtu"], paths["surface_vtu"]]
-    write_json(paths["summary"], data)
-    written.append(paths["summary"])
-    if not quiet:
-        _report(result, written, report)
-    if not result.converged:
-        raise typer.Exit(_fail(f"the solve did not converge: {result.reason}", 1))
+        _show(outcome)
+    if not outcome.result.converged:
+        raise typer.Exit(_fail(f"the solve did not converge: {outcome.result.reason}", 1))
 
 
 # ---------------------------------------------------------------------------- commands
 @app.command()
+@_with_options(SOLVE_OPTIONS)
 def pattern(
-    input: Annotated[Path, typer.Argument(help="Surface mesh (OBJ, STL, PLY, VTU, Gmsh, …).")],
-    output: OutOption = Path("pattern-out"),
-    material: MaterialOption = Law["neo-hooke"],
-    E: YoungOption = None,
-    nu: PoissonOption = None,
-    mu: ShearOption = None,
-    E1: E1Option = None,
-    E2: E2Option = None,
-    G12: G12Option = None,
-    nu12: Nu12Option = None,
-    A: AOption = None,
-    B: BOption = None,
-    C: COption = None,
-    fabric: FabricOption = None,
-    presets_file: PresetsOption = None,
-    thickness: ThicknessOption = 1.0,
-    warp_angle: WarpAngleOption = 0.0,
-    fill_angle: FillAngleOption = None,
-    warp_direction: WarpDirectionOption = None,
-    orientation: OrientationOption = Orientation.held,
-    prestress: PrestressOption = None,
-    prestress_field: PrestressFieldOption = None,
-    slack_threshold: SlackOption = 0.0,
-    strategy: StrategyOption = Strategy.auto,
-    steps: StepsOption = 3,
-    plane: Annotated[
-        str,
-        _opt(
-            "--plane",
-            help="Initial-guess plane: best-fit, xy, yz, zx, or a normal 'nx,ny,nz'.",
-            **_SOLVER,
-        ),
-    ] = "best-fit",
-    tolerance: ToleranceOption = 1e-10,
-    max_iterations: MaxIterationsOption = 50,
-    force: ForceOption = False,
-    quiet: QuietOption = False,
+    input: Annotated[Path, typer.Argument(help="Surface mesh (OBJ, STL, PLY, VTU, Gmsh, 3dm, …).")],
+    **options: Any,
 ) -> None:
     """Compute the cutting pattern of a surface mesh.
 
-    Writes OUTPUT/pattern.obj (the flat pattern, same nodes and faces as the input, z = 0),
-    OUTPUT/pattern.vtu and OUTPUT/surface.vtu (pattern and surface with every per-cell result,
-    for ParaView) and OUTPUT/summary.json (convergence, energy, areas, field ranges, history).
+    Writes pattern.obj, pattern.dxf, pattern.svg/.png, pattern.vtu, surface.vtu and summary.json
+    (and report.html with --report) into the output directory.
     """
-    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C, fabric, presets_file)
 
     def body() -> None:
-        built = options.build()
-        mesh, cell_data = read_mesh_data(input)
-        _solve_and_write(
-            mesh,
-            output,
-            built,
-            input_name=str(input),
-            write_input=False,
-            thickness=thickness,
-            warp_angle=warp_angle,
-            fill_angle=fill_angle,
-            warp_direction=warp_direction,
-            orientation=orientation,
-            prestress=_prestress(prestress, prestress_field, cell_data),
-            slack_threshold=slack_threshold,
-            strategy=strategy,
-            steps=steps,
-            plane=plane,
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            force=force,
-            quiet=quiet,
-        )
+        job = job_from_options({"mesh": str(input.resolve())}, options)
+        _execute(job, force=options["force"], quiet=options["quiet"], save_job=options["save_job"])
 
     _guarded(body)
 
 
 @app.command()
+@_with_options(SOLVE_OPTIONS)
 def example(
-    name: Annotated[str, typer.Argument(help="Example: " + ", ".join(example_surfaces.EXAMPLES))],
-    output: OutOption = Path("example-out"),
+    example_name: Annotated[
+        str,
+        typer.Argument(metavar="NAME", help="Example: " + ", ".join(example_surfaces.EXAMPLES)),
+    ],
     cell_type: Annotated[
         CellType, typer.Option("--cell-type", help="Mesh cells.", case_sensitive=False)
     ] = CellType.triangle,
-    material: MaterialOption = Law["neo-hooke"],
-    E: YoungOption = None,
-    nu: PoissonOption = None,
-    mu: ShearOption = None,
-    E1: E1Option = None,
-    E2: E2Option = None,
-    G12: G12Option = None,
-    nu12: Nu12Option = None,
-    A: AOption = None,
-    B: BOption = None,
-    C: COption = None,
-    fabric: FabricOption = None,
-    presets_file: PresetsOption = None,
-    thickness: ThicknessOption = 1.0,
-    warp_angle: WarpAngleOption = 0.0,
-    fill_angle: FillAngleOption = None,
-    warp_direction: WarpDirectionOption = None,
-    orientation: OrientationOption = Orientation.held,
-    prestress: PrestressOption = None,
-    prestress_field: PrestressFieldOption = None,
-    slack_threshold: SlackOption = 0.0,
-    strategy: StrategyOption = Strategy.auto,
-    steps: StepsOption = 3,
-    plane: Annotated[
-        str, _opt("--plane", help="Initial-guess plane (default: the example's own).", **_SOLVER)
-    ] = "",
-    tolerance: ToleranceOption = 1e-10,
-    max_iterations: MaxIterationsOption = 50,
-    force: ForceOption = False,
-    quiet: QuietOption = False,
+    **options: Any,
 ) -> None:
-    """Write a shipped example surface (OUTPUT/surface.obj) and compute its pattern."""
-    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C, fabric, presets_file)
+    """Write a shipped example surface (surface.obj) and compute its pattern."""
 
     def body() -> None:
-        if name not in example_surfaces.EXAMPLES:
-            raise InputError(
-                f"unknown example {name!r}; available: {', '.join(example_surfaces.EXAMPLES)}"
-            )
-        built = options.build()
-        mesh = example_surfaces.EXAMPLES[name](cell_type=str(cell_type))
-        _solve_and_write(
-            mesh,
-            output,
-            built,
-            input_name=name,
-            write_input=True,
-            thickness=thickness,
-            warp_angle=warp_angle,
-            fill_angle=fill_angle,
-            warp_direction=warp_direction,
-            orientation=orientation,
-            prestress=_prestress(prestress, prestress_field, None),
-            slack_threshold=slack_threshold,
-            strategy=strategy,
-            steps=steps,
-            plane=plane or example_surfaces.EXAMPLE_PLANES.get(name, "best-fit"),
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            force=force,
-            quiet=quiet,
-        )
+        job = job_from_options({"example": example_name, "cell_type": str(cell_type)}, options)
+        _execute(job, force=options["force"], quiet=options["quiet"], save_job=options["save_job"])
 
     _guarded(body)
 
 
 @app.command()
+def run(
+    job_file: Annotated[Path, typer.Argument(metavar="JOB", help="Job file (TOML).")],
+    force: Annotated[bool, typer.Option("--force", "-f", help="Overwrite output files.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Show no progress.")] = False,
+) -> None:
+    """Run a job file: input, material, fibres, prestress, solver and outputs in one TOML."""
+
+    def body() -> None:
+        _execute(load_job(job_file), force=force, quiet=quiet)
+
+    _guarded(body)
+
+
+EVALUATE_OPTIONS = [
+    p
+    for p in SOLVE_OPTIONS
+    if p.name
+    in (
+        "material",
+        "E",
+        "nu",
+        "mu",
+        "E1",
+        "E2",
+        "G12",
+        "nu12",
+        "A",
+        "B",
+        "C",
+        "fabric",
+        "presets",
+        "thickness",
+        "warp_angle",
+        "fill_angle",
+        "force",
+        "quiet",
+    )
+] + [
+    _option(Path("evaluation-out"), Path, "--output", "-o", help="Output directory.", panel=_O),
+    _option(
+        0.0,
+        float,
+        "--compression-threshold",
+        help="Yarn stresses below minus this count as compressed.",
+        panel=_O,
+    ),
+]
+
+
+@app.command()
+@_with_options(EVALUATE_OPTIONS)
 def evaluate(
     surface: Annotated[Path, typer.Argument(help="The 3D surface mesh.")],
     pattern_file: Annotated[
         Path, typer.Argument(metavar="PATTERN", help="Its pattern (e.g. pattern.obj).")
     ],
-    output: OutOption = Path("evaluation-out"),
-    material: MaterialOption = Law["neo-hooke"],
-    E: YoungOption = None,
-    nu: PoissonOption = None,
-    mu: ShearOption = None,
-    E1: E1Option = None,
-    E2: E2Option = None,
-    G12: G12Option = None,
-    nu12: Nu12Option = None,
-    A: AOption = None,
-    B: BOption = None,
-    C: COption = None,
-    fabric: FabricOption = None,
-    presets_file: PresetsOption = None,
-    thickness: ThicknessOption = 1.0,
-    warp_angle: WarpAngleOption = 0.0,
-    fill_angle: FillAngleOption = None,
-    force: ForceOption = False,
-    quiet: QuietOption = False,
+    **options: Any,
 ) -> None:
     """Evaluate a given pattern with a material and yarn directions (ply-stack check).
 
     Reports where the yarns go into compression (where a ply cut from this pattern wrinkles)
-    and writes OUTPUT/evaluation.json and OUTPUT/evaluation.vtu.
+    and writes evaluation.json and evaluation.vtu into the output directory.
     """
-    options = MaterialOptions(material, E, nu, mu, E1, E2, G12, nu12, A, B, C, fabric, presets_file)
 
     def body() -> None:
-        built = options.build()
-        mesh = read_mesh_data(surface)[0]
+        defaults = {
+            k: None
+            for k in (
+                "warp_direction",
+                "prestress",
+                "prestress_field",
+                "plane",
+                "linear_solver",
+                "mark_spacing",
+                "name",
+            )
+        }
+        job = job_from_options(
+            {"mesh": str(surface.resolve())},
+            {
+                **defaults,
+                **options,
+                "orientation": "held",
+                "slack_threshold": 0.0,
+                "strategy": "auto",
+                "steps": 3,
+                "tolerance": 1e-10,
+                "max_iterations": 50,
+                "report": False,
+                "units": "m",
+                "dxf_units": "mm",
+                "allowance": 0.0,
+            },
+        )
+        material = build_material(job)
+        mesh = read_mesh(surface)
         coordinates = read_pattern(pattern_file, mesh)
+        output = options["output"]
         paths = [output / "evaluation.json", output / "evaluation.vtu"]
-        check_writable(paths, force)
+        check_writable(paths, options["force"])
         result = evaluate_pattern(
-            mesh, coordinates, built, thickness, warp_angle=warp_angle, fill_angle=fill_angle
+            mesh,
+            coordinates,
+            material,
+            options["thickness"],
+            warp_angle=options["warp_angle"],
+            fill_angle=options["fill_angle"],
+            compression_threshold=options["compression_threshold"],
         )
         if result.inverted_cells.size:
             raise InputError(f"the pattern inverts {result.inverted_cells.size} cell(s)")
         data = {
             "surface": str(surface),
             "pattern": str(pattern_file),
-            "material": {"law": type(built).__name__, **built.parameters},
-            "warp_angle": warp_angle,
-            "fill_angle": fill_angle if fill_angle is not None else warp_angle + 90.0,
+            "material": {"law": type(material).__name__, **material.parameters},
+            "warp": result.fibres.warp,
+            "fill": result.fibres.fill,
             "energy": result.energy,
+            "compression_threshold": options["compression_threshold"],
             "compressed_cells": result.compressed_cells,
             "compressed_area_fraction": result.compressed_area_fraction,
             "fields": field_statistics(result.fields),
         }
         write_surface(paths[1], mesh, coordinates, result.fields)
         write_json(paths[0], data)
-        if not quiet:
+        if not options["quiet"]:
             console.print(_field_table(result.fields))
             console.print(
                 f"yarns in compression in {result.compressed_cells.size} of {mesh.num_cells} "
@@ -691,7 +616,9 @@ def evaluate(
 
 @app.command()
 def fabrics(
-    presets_file: PresetsOption = None,
+    presets_file: Annotated[
+        Path | None, typer.Option("--presets", help="TOML file with your own presets.")
+    ] = None,
 ) -> None:
     """List the fabric presets (typical values: use your own biaxial test values to cut)."""
 
@@ -710,8 +637,9 @@ def fabrics(
             table.add_row(
                 name, f"{p.E1:g}", f"{p.E2:g}", f"{p.G12:g}", f"{p.nu12:g}", p.description
             )
-        Console(highlight=False).print(table)
+        out = Console(highlight=False, soft_wrap=True)
+        out.print(table)
         for name, p in catalogue.items():
-            Console(highlight=False, soft_wrap=True).print(f"{name}: {p.source}")
+            out.print(f"{name}: {p.source}")
 
     _guarded(body)

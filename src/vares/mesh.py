@@ -8,6 +8,8 @@ single connected, open, manifold, consistently oriented surface without degenera
 
 from __future__ import annotations
 
+import contextlib
+import io
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -333,7 +335,8 @@ class SurfaceMesh:
 
 
 def read_mesh(path: str | Path) -> SurfaceMesh:
-    """Read a surface mesh from any format meshio reads (OBJ, STL, PLY, VTK/VTU, Gmsh, …).
+    """Read a surface mesh from any format meshio reads (OBJ, STL, PLY, VTK/VTU, Gmsh, …) or
+    from a Rhino ``.3dm`` file holding one mesh (see :mod:`vares.rhino`).
 
     Triangle and quad cells are kept; vertex and line cells (boundary markers in many
     formats) are ignored. Nodes that belong to no cell are dropped with a warning.
@@ -361,14 +364,29 @@ def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]
         raise FileNotFoundError(f"no such file: {path}")
     if path.stat().st_size == 0:
         raise MeshError(f"{path} is empty")
+    if path.suffix.lower() == ".3dm":
+        from .rhino import read_3dm
+
+        meshes = read_3dm(path)
+        if len(meshes) > 1:
+            names = ", ".join(m.name for m in meshes)
+            raise MeshError(f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels")
+        return meshes[0].mesh, {}
+    chatter = io.StringIO()  # some readers print their complaints: keep them for the error
     try:
-        with warnings.catch_warnings():
+        with (
+            warnings.catch_warnings(),
+            contextlib.redirect_stdout(chatter),
+            contextlib.redirect_stderr(chatter),
+        ):
             warnings.simplefilter("ignore")
             raw = meshio.read(path)
     except meshio.ReadError as exc:
         raise MeshError(f"cannot read {path}: {exc}") from exc
-    except Exception as exc:
-        raise MeshError(f"cannot read {path}: {type(exc).__name__}: {exc}") from exc
+    except (Exception, SystemExit) as exc:  # a reader may even exit on a broken file
+        detail = chatter.getvalue().strip().splitlines()
+        reason = detail[-1] if detail else f"{type(exc).__name__}: {exc}"
+        raise MeshError(f"cannot read {path}: {reason}") from None
 
     cells: dict[str, list[np.ndarray]] = {}
     data: dict[str, dict[str, list[np.ndarray]]] = {}

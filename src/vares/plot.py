@@ -16,7 +16,13 @@ from matplotlib.colors import Normalize, TwoSlopeNorm
 from .materials import Fibres
 from .mesh import SurfaceMesh
 
-__all__ = ["FIELD_LABELS", "plot_pattern", "save_pattern_figure"]
+__all__ = [
+    "FIELD_LABELS",
+    "plot_convergence",
+    "plot_pattern",
+    "plot_surface",
+    "save_pattern_figure",
+]
 
 #: Short colour bar labels of the per-cell fields; ``{stress}`` is replaced by the stress unit.
 FIELD_LABELS = {
@@ -143,3 +149,79 @@ def save_pattern_figure(path, *args, dpi: int = 150, **kwargs) -> None:
     fig = plot_pattern(*args, **kwargs)
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
+
+
+def plot_surface(
+    mesh: SurfaceMesh,
+    values: np.ndarray | None = None,
+    *,
+    field: str | None = None,
+    ax=None,
+    title: str | None = None,
+    stress_unit: str = "stress",
+) -> plt.Figure:
+    """3D view of the surface, optionally coloured by per-cell ``values``."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    if ax is None:
+        fig = plt.figure(figsize=(7, 5.5), layout="constrained")
+        ax = fig.add_subplot(projection="3d")
+    fig = ax.figure
+    polygons = [mesh.points[cell] for cells in mesh.cells.values() for cell in cells]
+    if values is None:
+        collection = Poly3DCollection(
+            polygons, facecolors="#d9e6f2", edgecolors="#5b7a99", linewidths=0.1
+        )
+    else:
+        values = np.asarray(values, dtype=float)
+        low, high = np.nanmin(values), np.nanmax(values)
+        centre = _CENTRED.get(field)
+        if centre is not None and low < centre < high:
+            norm, cmap = TwoSlopeNorm(centre, low, high), "RdBu_r"
+        else:
+            norm, cmap = Normalize(low, high if high > low else low + 1e-12), "viridis"
+        collection = Poly3DCollection(polygons, array=values, cmap=cmap, norm=norm, linewidths=0.0)
+        label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
+        fig.colorbar(collection, ax=ax, label=label, shrink=0.7)
+    ax.add_collection3d(collection)
+    low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    centre, half = 0.5 * (low + high), 0.5 * float(np.max(high - low))
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+def plot_convergence(history, ax=None, title: str | None = "convergence") -> plt.Figure:
+    """Relative residual of every Newton iteration (log scale), steps marked by colour."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 3.8), layout="constrained")
+    fig = ax.figure
+    residuals = np.array([r.relative_residual for r in history])
+    groups = [(r.strategy, r.step) for r in history]
+    start = 0
+    for k in range(1, len(history) + 1):
+        if k == len(history) or groups[k] != groups[start]:
+            strategy, step = groups[start]
+            ax.semilogy(
+                range(start, k),
+                residuals[start:k],
+                "o-",
+                markersize=3,
+                label=f"{strategy}, step {step}" if k - start > 0 else None,
+            )
+            start = k
+    ax.set_xlabel("Newton iteration (all steps)")
+    ax.set_ylabel("relative residual")
+    ax.grid(True, which="both", alpha=0.3)
+    if len({g for g in groups}) <= 8:
+        ax.legend(fontsize="small")
+    if title:
+        ax.set_title(title)
+    return fig

@@ -1,0 +1,352 @@
+"""Files for the cutter and for people: DXF, Rhino 3dm, drawings, the HTML report, job files."""
+
+import json
+import shutil
+import subprocess
+
+import dxfgrabber
+import ezdxf
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import vares
+from vares.cli import app
+from vares.dxf import CutPiece, boundary_loops, write_dxf
+from vares.examples import grid_cells
+from vares.job import JobError, load_job
+from vares.rhino import NamedMesh, read_3dm, write_3dm
+
+runner = CliRunner()
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def rectangle(width=2.0, height=1.0, nx=5, ny=3):
+    x, y = np.meshgrid(np.linspace(0, width, nx), np.linspace(0, height, ny))
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    return vares.SurfaceMesh(points, grid_cells(nx, ny, "quad"))
+
+
+def polylines(doc, layer):
+    return [
+        np.array(e.get_points("xy"))
+        for e in doc.modelspace().query(f"LWPOLYLINE[layer=='{layer}']")
+    ]
+
+
+def test_cut_line_of_a_rectangle_is_the_rectangle_grown_by_the_allowance(tmp_path):
+    mesh = rectangle()
+    path = tmp_path / "rect.dxf"
+    write_dxf(
+        path,
+        [CutPiece("rect", mesh, mesh.points[:, :2], warp=np.array([1.0, 0.0]))],
+        units="mm",
+        model_units="m",
+        allowance=25.0,
+    )
+    doc = ezdxf.readfile(path)
+    assert doc.header["$INSUNITS"] == 4  # millimetres
+    (seam,) = polylines(doc, "SEAM")
+    (cut,) = polylines(doc, "CUT")
+    low, high = seam.min(axis=0), seam.max(axis=0)
+    np.testing.assert_allclose(high - low, [2000.0, 1000.0], atol=1e-9)
+    np.testing.assert_allclose(cut.min(axis=0), low - 25.0, atol=1e-9)
+    np.testing.assert_allclose(cut.max(axis=0), high + 25.0, atol=1e-9)
+    assert len(cut) == 4  # clean (mitred) corners: still a rectangle
+    corners = {tuple(np.round(p, 6)) for p in cut}
+    expected = {
+        (low[0] - 25, low[1] - 25),
+        (high[0] + 25, low[1] - 25),
+        (high[0] + 25, high[1] + 25),
+        (low[0] - 25, high[1] + 25),
+    }
+    assert corners == {tuple(np.round(c, 6)) for c in expected}
+
+
+def test_dxf_layers_marks_labels_layout_and_other_readers(tmp_path):
+    mesh = rectangle()
+    pieces = [
+        CutPiece("A", mesh, mesh.points[:, :2], warp=np.array([1.0, 0.0]), label=["area 2 m²"]),
+        CutPiece("B", mesh, mesh.points[:, :2] * 0.5 + 7.0, warp=np.array([0.0, 1.0])),
+    ]
+    path = tmp_path / "two.dxf"
+    write_dxf(path, pieces, units="cm", allowance=5.0, mark_spacing=50.0)
+    doc = ezdxf.readfile(path)
+    auditor = doc.audit()
+    assert not auditor.has_errors and not auditor.has_fixes
+    assert doc.header["$INSUNITS"] == 5
+    assert {"SEAM", "CUT", "WARP", "MARKS", "LABEL"} <= {layer.dxf.name for layer in doc.layers}
+    marks = doc.modelspace().query("LINE[layer=='MARKS']")
+    assert len(marks) == 600 / 50 + 300 / 50  # perimeters 600 cm and 300 cm, every 50 cm
+    texts = [t.dxf.text for t in doc.modelspace().query("TEXT")]
+    assert texts == ["A", "area 2 m²", "B"]
+    cuts = polylines(doc, "CUT")
+    boxes = [(c.min(axis=0), c.max(axis=0)) for c in cuts]
+    assert boxes[0][1][0] < boxes[1][0][0]  # side by side, no overlap
+    # a reader with its own parser
+    grabbed = dxfgrabber.readfile(str(path))
+    assert grabbed.header["$INSUNITS"] == 5
+    types = [e.dxftype for e in grabbed.entities]
+    assert types.count("LWPOLYLINE") == 2 + 2 + 4 and types.count("TEXT") == 3
+    seam = next(e for e in grabbed.entities if e.dxftype == "LWPOLYLINE" and e.layer == "SEAM")
+    assert seam.is_closed and np.ptp(np.array(seam.points)[:, 0]) == pytest.approx(200.0)
+
+
+def test_dxf_renders_with_the_drawing_add_on(tmp_path):
+    import matplotlib.pyplot as plt
+    from ezdxf.addons.drawing import Frontend, RenderContext
+    from ezdxf.addons.drawing.matplotlib import MatplotlibBackend
+
+    result = vares.solve(vares.examples.hypar(n=6), vares.materials.NeoHooke(1000.0, 0.3))
+    path = tmp_path / "hypar.dxf"
+    write_dxf(
+        path,
+        [CutPiece("hypar", result.mesh, result.material_coordinates, warp=result.fibres.warp)],
+        allowance=20.0,
+        mark_spacing=500.0,
+    )
+    doc = ezdxf.readfile(path)
+    fig = plt.figure()
+    ax = fig.add_axes([0, 0, 1, 1])
+    Frontend(RenderContext(doc), MatplotlibBackend(ax)).draw_layout(doc.modelspace())
+    png = tmp_path / "hypar.png"
+    fig.savefig(png, dpi=60)
+    plt.close(fig)
+    assert png.stat().st_size > 3000
+    assert len(ax.collections) + len(ax.lines) + len(ax.patches) > 0
+
+
+def test_boundary_loops_with_a_hole():
+    x, y = np.meshgrid(np.arange(4.0), np.arange(4.0))
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(16)])
+    quads = grid_cells(4, 4, "quad")["quad"]
+    ring = np.delete(quads, 4, axis=0)  # remove the centre cell
+    loops = boundary_loops(vares.SurfaceMesh(points, {"quad": ring}))
+    assert [len(loop) for loop in loops] == [12, 4]
+    path_area = [
+        0.5
+        * np.sum(
+            points[loop, 0] * np.roll(points[loop, 1], -1)
+            - np.roll(points[loop, 0], -1) * points[loop, 1]
+        )
+        for loop in loops
+    ]
+    assert path_area[0] == pytest.approx(9.0) and path_area[1] == pytest.approx(-1.0)
+
+
+def test_rhino_3dm_round_trip_and_names(tmp_path):
+    sail = vares.examples.hypar(n=4)
+    arch = vares.examples.cylinder160(n_around=6, n_along=2, cell_type="quad")
+    path = tmp_path / "model.3dm"
+    write_3dm(path, [NamedMesh("sail", "membranes", sail), NamedMesh("", "roof::arch", arch)])
+    read = read_3dm(path)
+    assert [(m.name, m.layer) for m in read] == [
+        ("sail", "membranes"),
+        ("roof::arch", "roof::arch"),
+    ]
+    np.testing.assert_allclose(read[0].mesh.points, sail.points, rtol=1e-6)  # single precision
+    np.testing.assert_array_equal(read[1].mesh.cells["quad"], arch.cells["quad"])
+    with pytest.raises(vares.MeshError, match="holds 2 meshes"):
+        vares.read_mesh(path)
+    single = tmp_path / "sail.3dm"
+    write_3dm(single, [NamedMesh("sail", "membranes", sail)])
+    assert vares.read_mesh(single).num_cells == sail.num_cells
+    result = run("pattern", single, "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.stderr
+
+
+def test_rhino_files_without_meshes(tmp_path):
+    import rhino3dm
+
+    model = rhino3dm.File3dm()
+    model.Objects.AddBrep(rhino3dm.Sphere(rhino3dm.Point3d(0, 0, 0), 1.0).ToBrep())
+    path = tmp_path / "sphere.3dm"
+    model.Write(str(path), 7)
+    with pytest.raises(vares.MeshError, match=r"no usable mesh.*no render mesh"):
+        read_3dm(path)
+    broken = tmp_path / "broken.3dm"
+    broken.write_bytes(b"3D Geometry File Format  truncated")
+    with pytest.raises(vares.MeshError, match="cannot read"):
+        read_3dm(broken)
+
+
+def test_pattern_outputs_drawings_and_report_in_a_browser(tmp_path):
+    out = tmp_path / "sail"
+    result = run(
+        "example",
+        "sail",
+        "-o",
+        out,
+        "--fabric",
+        "pes-pvc-type-2",
+        "--prestress",
+        "2,1.5",
+        "--warp-direction",
+        "1,1,0",
+        "--report",
+        "--allowance",
+        30,
+        "--mark-spacing",
+        1000,
+        "-q",
+    )
+    assert result.exit_code == 0, result.stderr
+    for name in ("pattern.svg", "pattern.png", "report.html", "pattern.dxf"):
+        assert (out / name).stat().st_size > 10_000
+    assert (out / "pattern.svg").read_text()[:200].lstrip().startswith("<?xml")
+    assert (out / "pattern.png").read_bytes()[:4] == b"\x89PNG"
+    summary = json.loads((out / "summary.json").read_text())
+    chromium = shutil.which("chromium")
+    assert chromium, "Debian's chromium is needed (scripts/install-test-deps.sh installs it)"
+    dom = subprocess.run(
+        [
+            chromium,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            f"--user-data-dir={tmp_path / 'profile'}",
+            "--dump-dom",
+            (out / "report.html").as_uri(),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    ).stdout
+    assert "<h1>Cutting pattern: sail</h1>" in dom
+    assert 'class="status-ok">converged' in dom
+    area = f"{summary['surface_area']:.5g} m²"
+    assert f'<th>surface area</th><td class="num">{area}</td>' in dom
+    compensation = summary["compensation"]["warp"]["compensation_mean"]
+    assert f"{compensation:.3f}" in dom.split('id="compensation"')[1].split("</table>")[0]
+    assert dom.count("data:image/png;base64,") >= 9
+    for figure in (
+        "figure-convergence",
+        "figure-pattern",
+        "figure-det_F",
+        "figure-warp_stress",
+        "figure-surface-det_F",
+    ):
+        assert f'id="{figure}"' in dom
+    screenshot = tmp_path / "report.png"
+    subprocess.run(
+        [
+            chromium,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            f"--user-data-dir={tmp_path / 'profile2'}",
+            "--window-size=1000,1400",
+            f"--screenshot={screenshot}",
+            (out / "report.html").as_uri(),
+        ],
+        capture_output=True,
+        timeout=120,
+        check=True,
+    )
+    from PIL import Image
+
+    image = np.asarray(Image.open(screenshot).convert("L"), dtype=float)
+    assert image.std() > 10  # the page shows text and pictures, not a blank screen
+
+
+def test_job_files_run_save_and_report_bad_keys(tmp_path):
+    mesh = vares.examples.hypar(size=4.0, rise=0.2, n=6)
+    meshio.write(
+        tmp_path / "roof.ply", meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])])
+    )
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[input]\nmesh = "roof.ply"\n\n[material]\nfabric = "pes-pvc-type-3"\n\n'
+        "[fibres]\nwarp_direction = [1.0, 0.0, 0.0]\n\n[prestress]\nwarp = 2.0\nfill = 1.5\n\n"
+        '[output]\ndirectory = "out"\nallowance = 20.0\n'
+    )
+    result = run("run", job, "-q")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["converged"] and summary["material"]["E1"] == 1100.0
+    assert summary["compensation"]["warp"]["compensation_mean"] > 0
+    # the command line writes the job it ran; running that job gives the same pattern
+    saved = tmp_path / "saved.toml"
+    result = run(
+        "pattern",
+        tmp_path / "roof.ply",
+        "-o",
+        tmp_path / "cli",
+        "--fabric",
+        "pes-pvc-type-3",
+        "--warp-direction",
+        "1,0,0",
+        "--prestress",
+        "2,1.5",
+        "--save-job",
+        saved,
+        "-q",
+    )
+    assert result.exit_code == 0, result.stderr
+    assert load_job(saved).material == {"thickness": 1.0, "fabric": "pes-pvc-type-3"}
+    text = saved.read_text().replace(str(tmp_path / "cli"), str(tmp_path / "again"))
+    saved.write_text(text)
+    assert run("run", saved, "-q").exit_code == 0
+    a = meshio.read(tmp_path / "cli" / "pattern.obj").points
+    b = meshio.read(tmp_path / "again" / "pattern.obj").points
+    np.testing.assert_allclose(a, b, atol=1e-12)
+    np.testing.assert_allclose(a, meshio.read(tmp_path / "out" / "pattern.obj").points, atol=1e-9)
+    for text, message in [
+        (
+            '[input]\nmesh = "roof.ply"\n[solver]\ntolerence = 1e-8\n',
+            "[solver] unknown key 'tolerence'",
+        ),
+        (
+            '[input]\nmesh = "roof.ply"\n[material]\nthickness = "thick"\n',
+            "[material] thickness must be a number",
+        ),
+        ('[input]\nmesh = "roof.ply"\n[outputs]\nreport = true\n', "unknown section [outputs]"),
+        ("[input]\n", "[input] needs exactly one of mesh or example"),
+        ('[input]\nmesh = "roof.ply"\n[prestress]\nwarp = 2.0\n', "needs both warp and fill"),
+        ('[input]\nmesh = "roof.ply"\n[output]\nreport = 1\n', "report must be true or false"),
+        ("[input\n", "not valid TOML"),
+    ]:
+        job.write_text(text)
+        result = run("run", job, "-q")
+        assert result.exit_code == 2
+        line = [x for x in result.stderr.splitlines() if x.startswith("vares: error:")]
+        assert len(line) == 1 and message in line[0], (message, result.stderr)
+    with pytest.raises(JobError):
+        load_job(job)
+
+
+@pytest.mark.parametrize(
+    ("name", "content"),
+    [
+        ("empty.obj", b""),
+        ("truncated.stl", b"solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1"),
+        ("binary.stl", b"\x00" * 80 + b"\x05\x00\x00\x00" + b"\x00" * 20),
+        ("picture.obj", b"\x89PNG\r\n\x1a\n" + bytes(range(256))),
+        ("nan.obj", b"v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n"),
+        ("broken.vtu", b"<?xml version='1.0'?><VTKFile type='UnstructuredGrid'><Unstr"),
+    ],
+)
+def test_bad_files_fail_in_one_line_and_leave_no_output(tmp_path, name, content):
+    path = tmp_path / name
+    path.write_bytes(content)
+    out = tmp_path / "out"
+    result = run("pattern", path, "-o", out, "--report")
+    assert result.exit_code == 2
+    assert "Traceback" not in result.stdout + result.stderr
+    lines = [x for x in result.stderr.splitlines() if x.strip()]
+    assert len(lines) == 1 and lines[0].startswith("vares: error:"), result.stderr
+    assert not out.exists() or not any(out.iterdir())
