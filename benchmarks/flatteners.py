@@ -14,9 +14,10 @@ Surfaces: the 10 m × 10 m hyperbolic paraboloid ``z = 0.06 x y`` and the spheri
 
 Each run is a fresh process (after a warm-up on a tiny mesh, so library loading and compiled
 code caches are not timed); wall time is measured around the method's calls only, peak memory is
-the process's maximum resident set. Every pattern is then judged the same way: its energy under
-the common material (St. Venant–Kirchhoff, E = 1000, ν = 0.3, thickness 1), RMS and maximum
-edge strain (pattern length / 3D length − 1) and the number of inverted triangles.
+the process's peak resident set (VmHWM), imports included. Every pattern is then judged the same
+way: its energy under the common material (St. Venant–Kirchhoff, E = 1000, ν = 0.3,
+thickness 1), RMS and maximum edge strain (pattern length / 3D length − 1) and the number of
+inverted triangles.
 """
 
 from __future__ import annotations
@@ -111,6 +112,10 @@ def run_method(surface: str, triangles: int, method: str, solver: str | None, ou
         info["time"] = time.perf_counter() - start
         pattern = np.asarray(uv)[:, :2]
     np.save(out, pattern)
+    # this process's own peak resident set (VmHWM starts afresh at exec, unlike ru_maxrss,
+    # which a child inherits from a larger parent)
+    status = Path("/proc/self/status").read_text()
+    info["peak_mib"] = int(status.split("VmHWM:")[1].split()[0]) / 1024
     return info
 
 
@@ -175,9 +180,8 @@ def main() -> None:
                     command = [sys.executable, __file__, "--child", surface, str(size), method, out]
                     if args.solver:
                         command += ["--solver", args.solver]
-                    process = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
-                    _, status, usage = os.wait4(process.pid, 0)
-                    output = process.stdout.read()
+                    process = subprocess.run(command, stdout=subprocess.PIPE, text=True)
+                    status, output = process.returncode, process.stdout
                     if status != 0:
                         print(
                             f"{surface:<7} {mesh.num_cells:>9} {method:<6} failed (status {status})"
@@ -185,7 +189,7 @@ def main() -> None:
                         continue
                     info = json.loads(output.strip().splitlines()[-1])
                     quality = judge(mesh, np.load(out))
-                peak = usage.ru_maxrss / 1024
+                peak = info.pop("peak_mib")
                 notes = ""
                 if method == "vares":
                     notes = (

@@ -56,7 +56,7 @@ class InputError(Exception):
 def _option(
     default: Any, kind: Any, *names: str, help: str, panel: str, **extra
 ) -> inspect.Parameter:
-    name = names[0].lstrip("-").replace("-", "_")
+    name = names[0].split("/")[0].lstrip("-").replace("-", "_")
     option = typer.Option(*names, help=help, rich_help_panel=panel, **extra)
     return inspect.Parameter(
         name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=Annotated[kind, option]
@@ -641,5 +641,237 @@ def fabrics(
         out.print(table)
         for name, p in catalogue.items():
             out.print(f"{name}: {p.source}")
+
+    _guarded(body)
+
+
+PANEL_OPTIONS = [p for p in SOLVE_OPTIONS if p.name not in ("report", "save_job", "name")] + [
+    _option(
+        None,
+        str | None,
+        "--panel-field",
+        help="Cell data with a panel id per cell (one input mesh; default 'panel').",
+        panel="Panels",
+    ),
+    _option(
+        None,
+        str | None,
+        "--example",
+        help="Pattern a shipped structure instead: hypar-strips.",
+        panel="Panels",
+    ),
+    _option(
+        True,
+        bool,
+        "--match/--no-match",
+        help="Solve the panels together so that every seam has the same length on both sides.",
+        panel="Panels",
+    ),
+    _option(
+        None,
+        float | None,
+        "--roll-width",
+        help="Usable fabric roll width (mesh units): report panels wider across the warp.",
+        panel="Panels",
+    ),
+]
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "panel"
+
+
+@app.command()
+@_with_options(PANEL_OPTIONS)
+def panels(
+    inputs: Annotated[
+        list[Path] | None,
+        typer.Argument(
+            help="One mesh with a panel id per cell, a 3dm file with one object per "
+            "panel, or one mesh file per panel."
+        ),
+    ] = None,
+    **options: Any,
+) -> None:
+    """Pattern a structure of several panels with matching seams.
+
+    Writes one pattern per panel (NAME.obj), structure.dxf (all panels side by side, with match
+    marks at the same places on both sides of every seam) and structure.json (panels, seam
+    lengths before and after matching, the energy price of matching, roll width check).
+    """
+    from .examples import hypar_strips
+    from .panels import Panel, roll_width_check, solve_structure, split_panels
+    from .rhino import read_3dm
+    from .runner import seam_marks, solve_options
+
+    def body() -> None:
+        files = list(inputs or [])
+        if bool(files) == bool(options["example"]):
+            raise InputError("give input files or --example, not both and not neither")
+        source = {"mesh": str(files[0].resolve())} if files else {"example": "hypar"}
+        job = job_from_options(source, {**options, "report": False, "save_job": None, "name": None})
+        material = build_material(job)
+        cell_data: dict[str, np.ndarray] = {}
+        if options["example"] is not None:
+            if options["example"] != "hypar-strips":
+                raise InputError(
+                    f"unknown structure example {options['example']!r}; available: hypar-strips"
+                )
+            mesh, ids = hypar_strips()
+            structure_panels = split_panels(mesh, ids, {i: f"strip-{i + 1}" for i in range(6)})
+        elif len(files) == 1 and files[0].suffix.lower() == ".3dm":
+            structure_panels = [Panel(m.name, m.mesh) for m in read_3dm(files[0])]
+        elif len(files) == 1:
+            from .mesh import read_mesh_data
+
+            mesh, cell_data = read_mesh_data(files[0])
+            key = options["panel_field"] or "panel"
+            if key not in cell_data:
+                raise InputError(
+                    f"{files[0]} has no cell data {key!r} with panel ids "
+                    f"(it has: {', '.join(cell_data) or 'none'})"
+                )
+            structure_panels = split_panels(mesh, cell_data[key])
+        else:
+            structure_panels = [Panel(f.stem, read_mesh(f)) for f in files]
+        if len(structure_panels) < 2:
+            raise InputError("a structure needs at least two panels")
+        out = options["output"]
+        targets = [out / f"{_safe(p.name)}.obj" for p in structure_panels]
+        targets += [out / "structure.dxf", out / "structure.json"]
+        check_writable(targets, options["force"])
+        kwargs = solve_options(job, None)
+        if "field" in job.prestress:
+            raise InputError("per-cell prestress is not available for structures yet")
+        structure = solve_structure(
+            structure_panels,
+            material,
+            job.material.get("thickness", 1.0),
+            match_seams=options["match"],
+            linear_solver=job.solver.get("linear_solver"),
+            **kwargs,
+        )
+        names = [p.name for p in structure_panels]
+        too_wide = (
+            []
+            if options["roll_width"] is None
+            else roll_width_check(structure.results, names, options["roll_width"])
+        )
+        written = []
+        if structure.converged:
+            for panel, result, target in zip(
+                structure_panels, structure.results, targets, strict=False
+            ):
+                write_surface(target, panel.mesh, result.material_coordinates)
+                written.append(target)
+            from .dxf import UNITS, CutPiece, write_dxf
+
+            factor = UNITS[str(options["units"])][0] / UNITS[str(options["dxf_units"])][0]
+            spacing = (options["mark_spacing"] or 500.0) / factor
+            marks = seam_marks(structure, spacing)
+            pieces = [
+                CutPiece(
+                    p.name,
+                    p.mesh,
+                    r.material_coordinates,
+                    warp=r.fibres.warp,
+                    label=[f"pattern {r.pattern_area:.4g}"],
+                    marks=m,
+                )
+                for p, r, m in zip(structure_panels, structure.results, marks, strict=True)
+            ]
+            write_dxf(
+                out / "structure.dxf",
+                pieces,
+                units=str(options["dxf_units"]),
+                model_units=str(options["units"]),
+                allowance=options["allowance"],
+            )
+            written.append(out / "structure.dxf")
+        data = {
+            "matched": structure.matched,
+            "converged": structure.converged,
+            "reason": structure.reason,
+            "coupled_iterations": structure.iterations,
+            "energy_independent": structure.energy_independent,
+            "energy": structure.energy,
+            "energy_price": structure.energy_price,
+            "elapsed_seconds": structure.elapsed,
+            "material": {"law": type(material).__name__, **material.parameters},
+            "panels": [
+                {
+                    "name": p.name,
+                    "cells": p.mesh.num_cells,
+                    "surface_area": p.mesh.area,
+                    "pattern_area": r.pattern_area,
+                    "converged": r.converged,
+                    "iterations": r.iterations,
+                    "width_across_warp": float(
+                        np.ptp(
+                            r.material_coordinates @ np.array([-r.fibres.warp[1], r.fibres.warp[0]])
+                        )
+                    ),
+                }
+                for p, r in zip(structure_panels, structure.results, strict=True)
+            ],
+            "roll_width": options["roll_width"],
+            "too_wide": [{"panel": n, "width": w} for n, w in too_wide],
+            "seams": [
+                {
+                    **{
+                        k: getattr(s, k)
+                        for k in (
+                            "first",
+                            "second",
+                            "segments",
+                            "length_first_before",
+                            "length_second_before",
+                            "length_first_after",
+                            "length_second_after",
+                            "max_segment_mismatch_after",
+                        )
+                    },
+                    "mismatch_before": s.mismatch_before,
+                    "mismatch_after": s.mismatch_after,
+                }
+                for s in structure.seam_reports
+            ],
+        }
+        write_json(out / "structure.json", data)
+        written.append(out / "structure.json")
+        if not options["quiet"]:
+            table = Table(
+                "seam",
+                "segments",
+                "length A",
+                "length B",
+                "mismatch before",
+                "mismatch after",
+                title="seams (pattern lengths)",
+            )
+            for s in structure.seam_reports:
+                table.add_row(
+                    f"{s.first} | {s.second}",
+                    str(s.segments),
+                    f"{s.length_first_after:.6f}",
+                    f"{s.length_second_after:.6f}",
+                    f"{s.mismatch_before:.2e}",
+                    f"{s.mismatch_after:.2e}",
+                )
+            console.print(table)
+            console.print(
+                f"{len(structure_panels)} panels, {len(structure.seams)} seams; "
+                f"energy {structure.energy:.6e}, price of matching "
+                f"{structure.energy_price:.3e}; {structure.elapsed:.2f} s"
+            )
+            for name, width in too_wide:
+                console.print(
+                    f"[yellow]warning:[/] {name} is {width:.4g} wide across the "
+                    f"warp, more than the roll width {options['roll_width']:g}"
+                )
+            for path in written:
+                console.print(f"  wrote {path}")
+        if not structure.converged:
+            raise typer.Exit(_fail(f"the structure did not converge: {structure.reason}", 1))
 
     _guarded(body)

@@ -38,6 +38,7 @@ __all__ = [
     "graded_hypar",
     "grid_cells",
     "hypar",
+    "hypar_strips",
     "rib30",
     "spherical_cap",
 ]
@@ -375,6 +376,27 @@ def graded_hypar(
     t = np.linspace(-size / 2, size / 2, n + 1)
     x, y = (a.ravel() for a in np.meshgrid(s, t, indexing="xy"))
     return SurfaceMesh(np.column_stack([x, y, rise * x * y]), grid_cells(n + 1, n + 1, cell_type))
+
+
+def hypar_strips(
+    strips: int = 6,
+    size: float = 10.0,
+    height: float = 2.0,
+    cells_per_strip: int = 4,
+    n: int = 24,
+    cell_type: str = "triangle",
+) -> tuple[SurfaceMesh, np.ndarray]:
+    """A four-point sail cut into ``strips`` strips across x (seams along y), as a membrane is
+    welded from fabric of roll width: the mesh and the strip id of every cell."""
+    columns = strips * cells_per_strip
+    s_x = np.linspace(-size / 2, size / 2, columns + 1)
+    s_y = np.linspace(-size / 2, size / 2, n + 1)
+    x, y = (a.ravel() for a in np.meshgrid(s_x, s_y, indexing="xy"))
+    z = 2.0 * height / size**2 * x * y
+    mesh = SurfaceMesh(np.column_stack([x, y, z]), grid_cells(columns + 1, n + 1, cell_type))
+    centroid_x = np.concatenate([mesh.points[c][:, :, 0].mean(axis=1) for c in mesh.cells.values()])
+    ids = np.clip(((centroid_x + size / 2) / (size / strips)).astype(int), 0, strips - 1)
+    return mesh, ids
 
 
 #: Example generators by name (used by ``vares example``).

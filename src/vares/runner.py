@@ -32,7 +32,7 @@ from .materials import Hyperelastic, fabric, make_material
 from .mesh import SurfaceMesh, read_mesh_data
 from .solver import IterationRecord, PatternResult, solve
 
-__all__ = ["JobOutcome", "build_material", "run_job"]
+__all__ = ["JobOutcome", "build_material", "run_job", "seam_marks", "solve_options"]
 
 
 @dataclass
@@ -158,27 +158,14 @@ def run_job(
     check_writable(files.values(), force)
     if on_solve_start is not None:
         on_solve_start(name, mesh, material)
-    fibres, solver = job.fibres, job.solver
-    plane = solver.get("plane")
-    if plane is None and "example" in job.input:
-        plane = example_surfaces.EXAMPLE_PLANES.get(job.input["example"])
+    solver = job.solver
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = solve(
             mesh,
             material,
             job.material.get("thickness", 1.0),
-            warp_angle=fibres.get("warp_angle", 0.0),
-            fill_angle=fibres.get("fill_angle"),
-            warp_direction=fibres.get("warp_direction"),
-            orientation=fibres.get("orientation", "held"),
-            prestress=_prestress(job, cell_data),
-            strategy=solver.get("strategy", "auto"),
-            steps=solver.get("steps", 3),
-            initial_guess=solver.get("initial_guess"),
-            plane=None if plane in (None, "best-fit") else plane,
-            tolerance=solver.get("tolerance", 1e-10),
-            max_iterations=solver.get("max_iterations", 50),
+            **solve_options(job, cell_data),
             linear_solver=solver.get("linear_solver"),
             callback=callback,
         )
@@ -254,3 +241,46 @@ def _write_pattern_files(outcome: JobOutcome, files: dict[str, Path]) -> None:
             "surface.vtu",
         )
     ]
+
+
+def solve_options(job: Job, cell_data: dict[str, np.ndarray] | None = None) -> dict:
+    """The :func:`vares.solve` keyword arguments of a job (all but mesh, material, thickness)."""
+    fibres, solver = job.fibres, job.solver
+    plane = solver.get("plane")
+    if plane is None and "example" in job.input:
+        plane = example_surfaces.EXAMPLE_PLANES.get(job.input["example"])
+    return {
+        "warp_angle": fibres.get("warp_angle", 0.0),
+        "fill_angle": fibres.get("fill_angle"),
+        "warp_direction": fibres.get("warp_direction"),
+        "orientation": fibres.get("orientation", "held"),
+        "prestress": _prestress(job, cell_data or {}),
+        "strategy": solver.get("strategy", "auto"),
+        "steps": solver.get("steps", 3),
+        "initial_guess": solver.get("initial_guess"),
+        "plane": None if plane in (None, "best-fit") else plane,
+        "tolerance": solver.get("tolerance", 1e-10),
+        "max_iterations": solver.get("max_iterations", 50),
+    }
+
+
+def seam_marks(structure, spacing: float) -> list[np.ndarray]:
+    """Match mark points ``(k, 2)`` of every panel: at equal arc lengths, every ``spacing``
+    (model units), along each seam, on both sides (so both patterns get the same marks)."""
+    marks: list[list[np.ndarray]] = [[] for _ in structure.panels]
+    for seam in structure.seams:
+        sides = [
+            (seam.first, structure.results[seam.first].material_coordinates[seam.nodes_first]),
+            (seam.second, structure.results[seam.second].material_coordinates[seam.nodes_second]),
+        ]
+        length = np.linalg.norm(np.diff(sides[0][1], axis=0), axis=1).sum()
+        positions = np.arange(spacing, length - 0.25 * spacing, spacing)
+        for panel, chain in sides:
+            segment = np.linalg.norm(np.diff(chain, axis=0), axis=1)
+            cumulative = np.concatenate([[0.0], np.cumsum(segment)])
+            index = np.clip(
+                np.searchsorted(cumulative, positions, side="right") - 1, 0, len(segment) - 1
+            )
+            fraction = ((positions - cumulative[index]) / segment[index])[:, None]
+            marks[panel].append(chain[index] + fraction * (chain[index + 1] - chain[index]))
+    return [np.vstack(m) if m else np.zeros((0, 2)) for m in marks]
