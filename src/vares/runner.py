@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from . import examples as example_surfaces
+from .batch import job_digest
 from .compensation import CompensationReport, compensation_report
 from .dxf import CutPiece, write_dxf
 from .io import check_writable, summary, write_json, write_surface
@@ -179,6 +180,7 @@ def run_job(
 
     data = summary(result, name=name, input=job.input, tolerance=solver.get("tolerance", 1e-10))
     data["warnings"] = outcome.warnings
+    data["job_digest"] = job_digest(job)
     if report is not None:
         data["compensation"] = report.to_dict()
     if "surface.obj" in files:

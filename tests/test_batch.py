@@ -1,0 +1,78 @@
+"""Batches of jobs: local worker processes and a Dask cluster give the same patterns."""
+
+import json
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from vares.batch import is_complete, run_batch
+from vares.cli import app
+from vares.job import load_job
+
+runner = CliRunner()
+
+
+def write_jobs(folder, count=8):
+    paths = []
+    for k in range(count):
+        path = folder / f"job{k}.toml"
+        path.write_text(
+            f'[input]\nexample = "hypar"\n\n[material]\nlaw = "st-venant-kirchhoff"\n'
+            f"E = 1000.0\nnu = {0.1 + 0.04 * k}\n\n[fibres]\nwarp_angle = {10.0 * k}\n\n"
+            f'[output]\ndirectory = "out{k}"\n'
+        )
+        paths.append(path)
+    return paths
+
+
+def patterns(folder, count):
+    return [meshio.read(folder / f"out{k}" / "pattern.obj").points for k in range(count)]
+
+
+def test_local_batch_reports_failures_and_skips_complete_jobs(tmp_path):
+    paths = write_jobs(tmp_path, 3)
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[input]\nmesh = "missing.obj"\n')
+    seen = []
+    statuses = run_batch([*paths, bad], workers=2, callback=seen.append)
+    assert [s.status for s in statuses] == ["done", "done", "done", "failed"]
+    assert "no such file" in statuses[3].message
+    assert len(seen) == 4
+    assert all(is_complete(load_job(p)) for p in paths)
+    again = run_batch(paths, workers=2)
+    assert [s.status for s in again] == ["skipped"] * 3
+    # a changed job is not complete any more
+    paths[0].write_text(paths[0].read_text().replace("nu = 0.1", "nu = 0.2"))
+    assert not is_complete(load_job(paths[0]))
+    assert [s.status for s in run_batch(paths, workers=1)] == ["done", "skipped", "skipped"]
+
+
+def test_batch_command(tmp_path):
+    paths = write_jobs(tmp_path, 2)
+    result = runner.invoke(app, ["batch", *map(str, paths), "--workers", "1"])
+    assert result.exit_code == 0, result.stderr
+    assert "2 done" in result.stderr
+    summary = json.loads((tmp_path / "out1" / "summary.json").read_text())
+    assert summary["converged"] and summary["job_digest"]
+    result = runner.invoke(app, ["batch", str(paths[0]), str(tmp_path / "nope.toml")])
+    assert result.exit_code == 2 and "no such file" in result.stderr
+
+
+def test_dask_cluster_gives_the_same_patterns_as_local_workers(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    local, remote = tmp_path / "local", tmp_path / "dask"
+    local.mkdir()
+    remote.mkdir()
+    count = 8
+    assert all(s.status == "done" for s in run_batch(write_jobs(local, count), workers=2))
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
+        statuses = run_batch(write_jobs(remote, count), scheduler=cluster.scheduler_address)
+    assert [s.status for s in statuses] == ["done"] * count
+    for a, b in zip(patterns(local, count), patterns(remote, count), strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert not np.allclose(patterns(local, count)[0], patterns(local, count)[1])
