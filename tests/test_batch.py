@@ -68,7 +68,10 @@ def test_dask_cluster_gives_the_same_patterns_as_local_workers(tmp_path):
     count = 8
     assert all(s.status == "done" for s in run_batch(write_jobs(local, count), workers=2))
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
         dashboard_address=None,
     ) as cluster:
         statuses = run_batch(write_jobs(remote, count), scheduler=cluster.scheduler_address)

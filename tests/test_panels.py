@@ -152,3 +152,76 @@ def test_split_panels_errors():
     ids[0] = 7  # a single cell of panel 7 elsewhere: fine; a panel touching only at a node isn't
     panels = split_panels(mesh, ids)
     assert len(panels) == 3
+
+
+def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
+    import json
+
+    import meshio
+    from typer.testing import CliRunner
+
+    from vares.cli import app
+    from vares.rhino import NamedMesh, write_3dm
+
+    runner = CliRunner()
+    mesh, ids = hypar_strips(strips=3, cells_per_strip=3, n=9)
+    source = tmp_path / "sail.vtu"
+    meshio.write(
+        source,
+        meshio.Mesh(
+            mesh.points, [("triangle", mesh.cells["triangle"])], cell_data={"strip": [ids]}
+        ),
+    )
+    out = tmp_path / "cells"
+    result = runner.invoke(
+        app,
+        [
+            "panels",
+            str(source),
+            "--panel-field",
+            "strip",
+            "-o",
+            str(out),
+            "--fabric",
+            "pes-pvc-type-2",
+            "--prestress",
+            "2,1.5",
+            "--warp-direction",
+            "0,1,0",
+            "--mark-spacing",
+            "2000",
+            "--roll-width",
+            "3.0",
+            "-q",
+        ],
+    )
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "structure.json").read_text())
+    assert data["converged"] and data["matched"] and len(data["panels"]) == 3
+    assert all(s["mismatch_after"] < 1e-9 for s in data["seams"]) and len(data["seams"]) == 2
+    assert all(p["compensation"]["warp"]["compensation_mean"] > 0 for p in data["panels"])
+    assert data["too_wide"] == [] and data["energy_price"] >= 0
+    import ezdxf
+
+    doc = ezdxf.readfile(out / "structure.dxf")
+    marks = doc.modelspace().query("LINE[layer=='MARKS']")
+    assert len(marks) == 2 * 2 * 4  # 2 seams × 2 sides × marks every 2 m on a 10 m seam
+    # the same panels as a Rhino file and as separate files
+    panels = split_panels(mesh, ids, {0: "a", 1: "b", 2: "c"})
+    write_3dm(tmp_path / "sail.3dm", [NamedMesh(p.name, "membrane", p.mesh) for p in panels])
+    result = runner.invoke(
+        app,
+        ["panels", str(tmp_path / "sail.3dm"), "-o", str(tmp_path / "rhino"), "--no-match", "-q"],
+    )
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((tmp_path / "rhino" / "structure.json").read_text())
+    assert [p["name"] for p in data["panels"]] == ["a", "b", "c"] and not data["matched"]
+    assert max(s["mismatch_after"] for s in data["seams"]) > 1e-9  # not matched: not zero
+    files = []
+    for p in panels:
+        files.append(tmp_path / f"{p.name}.obj")
+        meshio.write(files[-1], meshio.Mesh(p.mesh.points, list(p.mesh.cells.items())))
+    result = runner.invoke(app, ["panels", *map(str, files), "-o", str(tmp_path / "files"), "-q"])
+    assert result.exit_code == 0, result.stderr
+    result = runner.invoke(app, ["panels", str(files[0]), "-o", str(tmp_path / "one")])
+    assert result.exit_code == 2 and "panel ids" in result.stderr

@@ -19,6 +19,7 @@ from rich.table import Table
 
 from . import examples as example_surfaces
 from .analysis import evaluate as evaluate_pattern
+from .compensation import compensation_report
 from .io import (
     OutputExistsError,
     atomic_path,
@@ -198,6 +199,14 @@ SOLVE_OPTIONS = [
     _option(None, str | None, "--name", help="Panel name for drawings and report.", panel=_O),
     _option(
         None,
+        str | None,
+        "--plot",
+        help="Fields to draw as pattern_FIELD.svg/.png and "
+        "surface_FIELD.png, e.g. 'det_F,warp_stress,shear_angle'.",
+        panel=_O,
+    ),
+    _option(
+        None,
         Path | None,
         "--save-job",
         help="Write the job as TOML (rerun with 'vares run').",
@@ -292,6 +301,8 @@ def job_from_options(source: dict[str, Any], o: dict[str, Any]) -> Job:
     }
     if o["mark_spacing"] is not None:
         output["mark_spacing"] = o["mark_spacing"]
+    if o.get("plot"):
+        output["plots"] = [f.strip() for f in o["plot"].split(",") if f.strip()]
     input_ = {**source, "units": str(o["units"])}
     if o["name"] is not None:
         input_["name"] = o["name"]
@@ -646,7 +657,9 @@ def fabrics(
     _guarded(body)
 
 
-PANEL_OPTIONS = [p for p in SOLVE_OPTIONS if p.name not in ("report", "save_job", "name")] + [
+PANEL_OPTIONS = [
+    p for p in SOLVE_OPTIONS if p.name not in ("report", "save_job", "name", "plot")
+] + [
     _option(
         None,
         str | None,
@@ -811,6 +824,11 @@ def panels(
                         np.ptp(
                             r.material_coordinates @ np.array([-r.fibres.warp[1], r.fibres.warp[0]])
                         )
+                    ),
+                    "compensation": (
+                        compensation_report(r, options["slack_threshold"]).to_dict()
+                        if r.converged
+                        else None
                     ),
                 }
                 for p, r in zip(structure_panels, structure.results, strict=True)

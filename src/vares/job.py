@@ -32,6 +32,7 @@ is checked; an unknown key or a value of the wrong kind is an error that names i
     dxf_units = "mm"
     allowance = 20.0             # seam allowance, DXF units
     mark_spacing = 500.0         # match marks, DXF units
+    plots = ["det_F", "warp_stress"]   # also pattern_FIELD.svg/.png and surface_FIELD.png
 
 Relative paths are relative to the job file.
 """
@@ -102,6 +103,7 @@ SCHEMA: dict[str, dict[str, Any]] = {
         "dxf_units": str,
         "allowance": _NUMBER,
         "mark_spacing": _NUMBER,
+        "plots": list,
     },
 }
 
@@ -165,6 +167,14 @@ class Job:
             raise JobError(f"{origin}: [prestress] give warp/fill or field, not both")
         if ("warp" in self.prestress) != ("fill" in self.prestress):
             raise JobError(f"{origin}: [prestress] needs both warp and fill")
+        from .analysis import FIELD_DESCRIPTIONS
+
+        unknown = [f for f in self.output.get("plots", []) if f not in FIELD_DESCRIPTIONS]
+        if unknown:
+            raise JobError(
+                f"{origin}: [output] plots: unknown field {unknown[0]!r} (fields: "
+                f"{', '.join(FIELD_DESCRIPTIONS)})"
+            )
 
     def path(self, value: str) -> Path:
         """A path from the job, relative to the job file's folder."""

@@ -109,6 +109,9 @@ def _outputs(job: Job, is_example: bool) -> dict[str, Path]:
             "surface.vtu",
         )
     }
+    for name in job.output.get("plots", []):
+        for key in (f"pattern_{name}.svg", f"pattern_{name}.png", f"surface_{name}.png"):
+            files[key] = out / key
     if is_example:
         files["surface.obj"] = out / "surface.obj"
     if job.output.get("report", False):
@@ -202,7 +205,7 @@ def _write_pattern_files(outcome: JobOutcome, files: dict[str, Path]) -> None:
     import matplotlib.pyplot as plt
 
     from .io import atomic_path
-    from .plot import plot_pattern
+    from .plot import plot_pattern, plot_surface
 
     job, result, mesh = outcome.job, outcome.result, outcome.mesh
     x = result.material_coordinates
@@ -227,21 +230,41 @@ def _write_pattern_files(outcome: JobOutcome, files: dict[str, Path]) -> None:
         allowance=output.get("allowance", 0.0),
         mark_spacing=output.get("mark_spacing"),
     )
-    fig = plot_pattern(mesh, x, fibres=result.fibres, title=f"{outcome.name}: pattern")
-    for key in ("pattern.svg", "pattern.png"):
-        with atomic_path(files[key]) as temporary:
-            fig.savefig(temporary, dpi=150)
-    plt.close(fig)
-    outcome.files += [
-        files[k]
-        for k in (
-            "pattern.obj",
-            "pattern.dxf",
-            "pattern.svg",
-            "pattern.png",
-            "pattern.vtu",
-            "surface.vtu",
+
+    def save(fig, keys: tuple[str, ...]) -> None:
+        for key in keys:
+            with atomic_path(files[key]) as temporary:
+                fig.savefig(temporary, dpi=150)
+            outcome.files.append(files[key])
+        plt.close(fig)
+
+    save(
+        plot_pattern(mesh, x, fibres=result.fibres, title=f"{outcome.name}: pattern"),
+        ("pattern.svg", "pattern.png"),
+    )
+    unit = "force/length" if result.thickness == 1.0 else "stress"
+    for name in output.get("plots", []):
+        values = result.fields[name]
+        save(
+            plot_pattern(
+                mesh,
+                x,
+                values,
+                field=name,
+                fibres=result.fibres,
+                stress_unit=unit,
+                title=f"{outcome.name}: {name}",
+            ),
+            (f"pattern_{name}.svg", f"pattern_{name}.png"),
         )
+        save(
+            plot_surface(
+                mesh, values, field=name, stress_unit=unit, title=f"{outcome.name}: {name}"
+            ),
+            (f"surface_{name}.png",),
+        )
+    outcome.files += [
+        files[k] for k in ("pattern.obj", "pattern.dxf", "pattern.vtu", "surface.vtu")
     ]
 
 
