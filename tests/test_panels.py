@@ -191,7 +191,7 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
             "--mark-spacing",
             "2000",
             "--roll-width",
-            "3.0",
+            "3.5",
             "-q",
         ],
     )

@@ -355,23 +355,8 @@ def _compensation_table(report) -> Table:
         "fill",
         title="compensation and prestress (force per length; means area-weighted)",
     )
-    rows = [
-        ("compensation, mean", lambda y: f"{y.compensation_mean:.3f} %"),
-        (
-            "compensation, min … max",
-            lambda y: f"{y.compensation_min:.3f} … {y.compensation_max:.3f} %",
-        ),
-        ("target prestress", lambda y: f"{y.target_mean:.4g}"),
-        ("achieved, mean", lambda y: f"{y.achieved_mean:.4g}"),
-        ("achieved, min … max", lambda y: f"{y.achieved_min:.4g} … {y.achieved_max:.4g}"),
-        ("RMS deviation from target", lambda y: f"{y.rms_deviation:.3g}"),
-        (
-            f"slack: below {report.slack_threshold:g}",
-            lambda y: f"{100 * y.slack_area_fraction:.1f} % ({y.slack_cells} cells)",
-        ),
-    ]
-    for label, cell in rows:
-        table.add_row(label, cell(report.warp), cell(report.fill))
+    for row in report.rows():
+        table.add_row(*row)
     return table
 
 

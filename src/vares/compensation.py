@@ -49,6 +49,25 @@ class CompensationReport:
     def to_dict(self) -> dict[str, object]:
         return asdict(self)
 
+    def rows(self) -> list[tuple[str, str, str]]:
+        """The report as text rows ``(label, warp, fill)`` for tables."""
+        formats = (
+            ("compensation, mean", lambda y: f"{y.compensation_mean:.3f} %"),
+            (
+                "compensation, min … max",
+                lambda y: f"{y.compensation_min:.3f} … {y.compensation_max:.3f} %",
+            ),
+            ("target prestress", lambda y: f"{y.target_mean:.4g}"),
+            ("achieved, mean", lambda y: f"{y.achieved_mean:.4g}"),
+            ("achieved, min … max", lambda y: f"{y.achieved_min:.4g} … {y.achieved_max:.4g}"),
+            ("RMS deviation from target", lambda y: f"{y.rms_deviation:.3g}"),
+            (
+                f"slack: below {self.slack_threshold:g}",
+                lambda y: f"{100 * y.slack_area_fraction:.1f} % ({y.slack_cells} cells)",
+            ),
+        )
+        return [(label, text(self.warp), text(self.fill)) for label, text in formats]
+
 
 def _yarn(fields, yarn: str, target: np.ndarray, thickness: float, threshold: float):
     weight = fields["surface_area"]

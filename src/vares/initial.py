@@ -59,15 +59,9 @@ class ProjectionPlane:
         return points - (1.0 - tau) * np.outer(self.height(points), self.normal)
 
 
-def _signed_projected_area(mesh: SurfaceMesh, axes: np.ndarray) -> float:
-    coordinates = mesh.points @ axes.T
-    total = 0.0
-    for cell_type, cells in mesh.cells.items():
-        element = ELEMENTS[cell_type]
-        j = element.jacobians(coordinates, cells)
-        det = j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
-        total += float(np.sum(det @ element.quadrature_weights))
-    return total
+def signed_area(mesh: SurfaceMesh, coordinates: np.ndarray) -> float:
+    """Total signed area of the mesh laid out at 2D ``coordinates`` (negative if mirrored)."""
+    return float(sum(ELEMENTS[t].areas(coordinates, c).sum() for t, c in mesh.cells.items()))
 
 
 def projection_plane(mesh: SurfaceMesh, plane: PlaneSpec = None) -> ProjectionPlane:
@@ -107,7 +101,7 @@ def projection_plane(mesh: SurfaceMesh, plane: PlaneSpec = None) -> ProjectionPl
         first = candidate - (candidate @ normal) * normal
     first = first / np.linalg.norm(first)
     axes = np.array([first, np.cross(normal, first)])
-    if _signed_projected_area(mesh, axes) < 0:
+    if signed_area(mesh, mesh.points @ axes.T) < 0:
         axes[1] = -axes[1]  # view from the other side so the pattern keeps the cell orientation
     return ProjectionPlane(origin, axes)
 
@@ -184,20 +178,10 @@ def lscm(mesh: SurfaceMesh) -> np.ndarray:
     solution[free] = spsolve(normal_matrix, rhs)
     coordinates = solution.reshape(-1, 2)
     coordinates -= coordinates.mean(axis=0)
-    flat_area = _signed_area(mesh, coordinates)
+    flat_area = signed_area(mesh, coordinates)
     if flat_area <= 0:
         raise ValueError("the conformal map is degenerate for this surface")
     return coordinates * np.sqrt(mesh.area / flat_area)
-
-
-def _signed_area(mesh: SurfaceMesh, coordinates: np.ndarray) -> float:
-    total = 0.0
-    for cell_type, cells in mesh.cells.items():
-        element = ELEMENTS[cell_type]
-        j = element.jacobians(coordinates, cells)
-        det = j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
-        total += float(np.sum(det @ element.quadrature_weights))
-    return total
 
 
 def projection_distortion(mesh: SurfaceMesh, plane: ProjectionPlane) -> float:

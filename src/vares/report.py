@@ -175,32 +175,7 @@ def html_report(outcome: JobOutcome) -> str:
     parts += ["<h2>Key figures</h2>", _table(key, ident="key-figures")]
 
     if outcome.compensation is not None and result.prestress is not None:
-        c = outcome.compensation
-        rows = []
-        for label, attribute, fmt in (
-            ("compensation, mean [%]", "compensation_mean", "{:.3f}"),
-            ("compensation, min [%]", "compensation_min", "{:.3f}"),
-            ("compensation, max [%]", "compensation_max", "{:.3f}"),
-            ("target prestress", "target_mean", "{:.4g}"),
-            ("achieved, mean", "achieved_mean", "{:.4g}"),
-            ("achieved, min", "achieved_min", "{:.4g}"),
-            ("achieved, max", "achieved_max", "{:.4g}"),
-            ("RMS deviation", "rms_deviation", "{:.3g}"),
-        ):
-            rows.append(
-                (
-                    label,
-                    fmt.format(getattr(c.warp, attribute)),
-                    fmt.format(getattr(c.fill, attribute)),
-                )
-            )
-        rows.append(
-            (
-                f"slack area (below {c.slack_threshold:g})",
-                f"{100 * c.warp.slack_area_fraction:.1f} %",
-                f"{100 * c.fill.slack_area_fraction:.1f} %",
-            )
-        )
+        rows = outcome.compensation.rows()
         parts += [
             "<h2>Compensation and prestress</h2>",
             _table(rows, header=("", "warp", "fill"), ident="compensation"),

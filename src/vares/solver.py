@@ -32,7 +32,14 @@ import scipy.sparse as sp
 
 from .assembly import Assembler
 from .elements import ELEMENTS
-from .initial import PlaneSpec, ProjectionPlane, lscm, projection_distortion, projection_plane
+from .initial import (
+    PlaneSpec,
+    ProjectionPlane,
+    lscm,
+    projection_distortion,
+    projection_plane,
+    signed_area,
+)
 from .kernels import determinant
 from .linalg import LinearSolver, SingularMatrixError, get_solver
 from .materials import Fibres, Hyperelastic
@@ -148,14 +155,7 @@ class PatternResult:
 
     @property
     def pattern_area(self) -> float:
-        from .elements import ELEMENTS
-
-        return float(
-            sum(
-                ELEMENTS[t].areas(self.material_coordinates, c).sum()
-                for t, c in self.mesh.cells.items()
-            )
-        )
+        return signed_area(self.mesh, self.material_coordinates)
 
     @property
     def fields(self) -> dict[str, np.ndarray]:
