@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.collections import PolyCollection
 from matplotlib.colors import Normalize, TwoSlopeNorm
 
+from .analysis import FIELD_DESCRIPTIONS
 from .materials import Fibres
 from .mesh import SurfaceMesh
 
@@ -66,6 +67,36 @@ _CENTRED = {
 }
 
 
+#: Spreads below these are round-off: such fields are drawn in one colour (unitless, degrees, %).
+_MIN_SPAN = {
+    "det_F": 1e-6,
+    "warp_stretch": 1e-6,
+    "fill_stretch": 1e-6,
+    "stretch_max": 1e-6,
+    "stretch_min": 1e-6,
+    "shear_angle": 1e-4,
+    "warp_deviation": 1e-4,
+    "warp_compensation": 1e-4,
+    "fill_compensation": 1e-4,
+}
+
+
+def _colour_scale(values, field, value_range, stress_scale):
+    """Norm and colour map: diverging about the neutral value where there is one; a spread
+    below round-off level (per field, or 1e-6 × ``stress_scale`` for stresses) is widened so
+    such a field shows as uniform instead of as amplified noise."""
+    low, high = value_range if value_range is not None else (np.nanmin(values), np.nanmax(values))
+    unit = FIELD_DESCRIPTIONS.get(field, ("", ""))[1]
+    span = _MIN_SPAN.get(field, 1e-6 * stress_scale if unit == "stress" and stress_scale else 0)
+    if high - low < span:
+        middle = 0.5 * (low + high)
+        low, high = middle - 0.5 * span, middle + 0.5 * span
+    centre = _CENTRED.get(field)
+    if centre is not None and low < centre < high:
+        return TwoSlopeNorm(centre, low, high), "RdBu_r"
+    return Normalize(low, high if high > low else low + 1e-12), "viridis"
+
+
 def _polygons(mesh: SurfaceMesh, coordinates: np.ndarray) -> list[np.ndarray]:
     return [coordinates[cell] for cells in mesh.cells.values() for cell in cells]
 
@@ -82,11 +113,13 @@ def plot_pattern(
     stress_unit: str = "stress",
     value_range: Sequence[float] | None = None,
     edges: bool = False,
+    stress_scale: float | None = None,
 ) -> plt.Figure:
     """Draw a pattern ``(n, 2)``, optionally coloured by per-cell ``values`` (global order).
 
     ``field`` names the values (for the colour bar label and a centred colour scale); ``fibres``
-    draws warp (solid) and fill (dashed) arrows; ``value_range`` fixes the colour scale.
+    draws warp (solid) and fill (dashed) arrows; ``value_range`` fixes the colour scale;
+    ``stress_scale`` (e.g. the material's stiffness) sets the round-off level of stress fields.
     """
     if ax is None:
         width, height = np.ptp(coordinates, axis=0)
@@ -102,16 +135,7 @@ def plot_pattern(
         ax.add_collection(collection)
     else:
         values = np.asarray(values, dtype=float)
-        low, high = (
-            value_range if value_range is not None else (np.nanmin(values), np.nanmax(values))
-        )
-        centre = _CENTRED.get(field)
-        if centre is not None and low < centre < high:
-            norm = TwoSlopeNorm(centre, low, high)
-            cmap = "RdBu_r"
-        else:
-            norm = Normalize(low, high if high > low else low + 1e-12)
-            cmap = "viridis"
+        norm, cmap = _colour_scale(values, field, value_range, stress_scale)
         collection = PolyCollection(
             polygons,
             array=values,
@@ -159,6 +183,7 @@ def plot_surface(
     ax=None,
     title: str | None = None,
     stress_unit: str = "stress",
+    stress_scale: float | None = None,
 ) -> plt.Figure:
     """3D view of the surface, optionally coloured by per-cell ``values``."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -174,12 +199,7 @@ def plot_surface(
         )
     else:
         values = np.asarray(values, dtype=float)
-        low, high = np.nanmin(values), np.nanmax(values)
-        centre = _CENTRED.get(field)
-        if centre is not None and low < centre < high:
-            norm, cmap = TwoSlopeNorm(centre, low, high), "RdBu_r"
-        else:
-            norm, cmap = Normalize(low, high if high > low else low + 1e-12), "viridis"
+        norm, cmap = _colour_scale(values, field, None, stress_scale)
         collection = Poly3DCollection(polygons, array=values, cmap=cmap, norm=norm, linewidths=0.0)
         label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
         fig.colorbar(collection, ax=ax, label=label, shrink=0.7)

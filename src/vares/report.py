@@ -210,6 +210,7 @@ def html_report(outcome: JobOutcome) -> str:
 
     if result.converged:
         x = result.material_coordinates
+        scale = material.stiffness_scale * result.thickness
         parts += [
             "<h2>Pattern</h2>",
             _figure(
@@ -222,7 +223,13 @@ def html_report(outcome: JobOutcome) -> str:
             parts.append(
                 _figure(
                     plot_pattern(
-                        mesh, x, fields[name], field=name, fibres=result.fibres, title=name
+                        mesh,
+                        x,
+                        fields[name],
+                        field=name,
+                        fibres=result.fibres,
+                        title=name,
+                        stress_scale=scale,
                     ),
                     f"{name} on the pattern",
                     f"figure-{name}",
@@ -236,7 +243,13 @@ def html_report(outcome: JobOutcome) -> str:
                 "figure-surface-det_F",
             ),
             _figure(
-                plot_surface(mesh, fields["warp_stress"], field="warp_stress", title="warp stress"),
+                plot_surface(
+                    mesh,
+                    fields["warp_stress"],
+                    field="warp_stress",
+                    title="warp stress",
+                    stress_scale=scale,
+                ),
                 "warp stress on the 3D surface",
                 "figure-surface-warp_stress",
             ),

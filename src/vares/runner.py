@@ -243,6 +243,7 @@ def _write_pattern_files(outcome: JobOutcome, files: dict[str, Path]) -> None:
         ("pattern.svg", "pattern.png"),
     )
     unit = "force/length" if result.thickness == 1.0 else "stress"
+    scale = outcome.material.stiffness_scale * result.thickness
     for name in output.get("plots", []):
         values = result.fields[name]
         save(
@@ -253,13 +254,19 @@ def _write_pattern_files(outcome: JobOutcome, files: dict[str, Path]) -> None:
                 field=name,
                 fibres=result.fibres,
                 stress_unit=unit,
+                stress_scale=scale,
                 title=f"{outcome.name}: {name}",
             ),
             (f"pattern_{name}.svg", f"pattern_{name}.png"),
         )
         save(
             plot_surface(
-                mesh, values, field=name, stress_unit=unit, title=f"{outcome.name}: {name}"
+                mesh,
+                values,
+                field=name,
+                stress_unit=unit,
+                stress_scale=scale,
+                title=f"{outcome.name}: {name}",
             ),
             (f"surface_{name}.png",),
         )
