@@ -266,10 +266,10 @@ def _newton(
     - ``"full"``: plain Newton, full steps; a step that inverts a cell ends it.
     - ``"line-search"``: globalised Newton. The step is bounded so that every ``det J`` stays
       positive and backtracked until the energy decreases enough (Armijo). Far from the
-      solution the tangent is the element-wise positive semi-definite projection of the exact
-      one (projected Newton: always a descent direction); once the relative residual is below
-      ``_EXACT_TANGENT_BELOW`` the exact tangent is used, so the final convergence is
-      quadratic, with the projection as fallback whenever the exact step is no descent.
+      solution (relative residual at or above ``_EXACT_TANGENT_BELOW``) the tangent is the
+      quadrature-point-wise positive semi-definite projection of the exact one (projected
+      Newton: always a descent direction); below it the exact tangent, so the final convergence
+      is quadratic, with the projection as fallback whenever the exact step is no descent.
     - ``"damped"``: each iteration solves ``(K + c I) ΔX = −r`` and accepts the step only if it
       lowers the energy without inverting a cell; ``c`` (starting at ``damping`` × the mean
       tangent diagonal) follows the gain ratio of actual to predicted decrease (Nielsen's rule)
@@ -282,14 +282,21 @@ def _newton(
     initial_residual = None
     identity = sp.identity(ctx.assembler.num_free, format="csr")
     c, growth = None, 2.0
-    projected = True  # far from the solution until the residual says otherwise
     step_length, tangent = 0.0, ""
     for iteration in range(ctx.max_iterations + 1):
-        evaluation = problem.evaluate(x, order=2, projected=method == "line-search" and projected)
+        evaluation = problem.evaluate(x, order=2)
         residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
         residual = float(np.linalg.norm(residual_vector))
         initial_residual = residual if initial_residual is None else initial_residual
         converged = residual <= ctx.residual_tolerance
+        # far from the solution (by the residual) the projected tangent, near it the exact one
+        projected = (
+            method == "line-search"
+            and not converged
+            and residual >= _EXACT_TANGENT_BELOW * ctx.force_scale
+        )
+        if projected:
+            evaluation = problem.evaluate(x, order=2, projected=True)
         matrix = None if converged else ctx.assembler.matrix(evaluation.hessians)
         if method == "damped" and matrix is not None:
             scale = damping * float(np.mean(np.abs(matrix.diagonal())))
@@ -381,8 +388,6 @@ def _newton(
         else:
             raise _Failure("the line search found no decrease of the energy", x)
         tangent = "projected" if projected else "exact"
-        if projected and residual < _EXACT_TANGENT_BELOW * ctx.force_scale:
-            projected = False  # near the solution: back to the exact tangent
         x, step_length = trial, alpha
     raise AssertionError("unreachable")
 
