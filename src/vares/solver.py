@@ -723,11 +723,12 @@ def solve(
             offset = _angle(fibres.fill) - _angle(fibres.warp)
             fibres = Fibres.from_angles(theta, theta + offset)
             problem = make_problem(fibres)
+        resume = start  # a whole-surface attempt goes on from where the last one stopped
         for name, taus, method in _plan(strategy, steps, projection is not None):
             path.append(name)
             try:
                 if taus is None:
-                    x = _single(problem, start, ctx, name, method, damping)
+                    x = _single(problem, resume, ctx, name, method, damping)
                 else:
                     x = _run_steps(
                         problem,
@@ -745,6 +746,8 @@ def solve(
             except _Failure as failure:
                 reason = failure.reason
                 x = failure.coordinates
+                if taus is None:
+                    resume = x  # never inverted, lower energy than the start
         if reason is None and direction is not None:
             path.append("warp alignment")
             try:
