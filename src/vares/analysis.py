@@ -44,6 +44,18 @@ FIELD_DESCRIPTIONS: dict[str, tuple[str, str]] = {
     "warp_deviation": ("angle from the prescribed 3D warp direction to the erected warp", "degree"),
 }
 
+#: The fields a summary table shows first.
+KEY_FIELDS = (
+    "det_F",
+    "warp_stretch",
+    "fill_stretch",
+    "shear_angle",
+    "warp_stress",
+    "fill_stress",
+    "stress_min",
+    "stress_max",
+)
+
 #: Compressive stresses below this fraction of the material's stiffness are round-off.
 COMPRESSION_TOLERANCE = 1e-8
 

@@ -18,6 +18,7 @@ from rich.console import Console
 from rich.table import Table
 
 from . import examples as example_surfaces
+from .analysis import KEY_FIELDS
 from .analysis import evaluate as evaluate_pattern
 from .compensation import compensation_report
 from .io import (
@@ -327,16 +328,7 @@ def _progress(quiet: bool):
     return show
 
 
-_TABLE_FIELDS = (
-    "det_F",
-    "warp_stretch",
-    "fill_stretch",
-    "shear_angle",
-    "warp_stress",
-    "fill_stress",
-    "stress_min",
-    "stress_max",
-)
+_TABLE_FIELDS = KEY_FIELDS
 
 
 def _field_table(fields: dict[str, np.ndarray]) -> Table:

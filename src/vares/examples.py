@@ -293,6 +293,17 @@ def cap_over_square(
     return SurfaceMesh(points, grid_cells(n + 1, n + 1, cell_type))
 
 
+def _revolution(
+    radius: np.ndarray, height: np.ndarray, angle: float, n_around: int, cell_type: str
+) -> SurfaceMesh:
+    """The profile ``(radius, height)`` swept by ``angle`` degrees (centred on +x) about z."""
+    phi = np.radians(np.linspace(-angle / 2, angle / 2, n_around + 1))
+    r, p = np.meshgrid(radius, phi, indexing="xy")
+    z = np.tile(height, len(phi))
+    points = np.column_stack([(r * np.cos(p)).ravel(), (r * np.sin(p)).ravel(), z])
+    return SurfaceMesh(points, grid_cells(len(radius), len(phi), cell_type))
+
+
 def cone_segment(
     apex_angle: float = 60.0,
     angle: float = 120.0,
@@ -306,13 +317,7 @@ def cone_segment(
     degrees around, slant distances ``inner`` … ``outer`` from the apex."""
     half = np.radians(apex_angle) / 2
     s = np.linspace(inner, outer, n_radial + 1)
-    phi = np.radians(np.linspace(-angle / 2, angle / 2, n_around + 1))
-    ss, pp = np.meshgrid(s, phi, indexing="xy")
-    r = ss * np.sin(half)
-    points = np.column_stack(
-        [(r * np.cos(pp)).ravel(), (r * np.sin(pp)).ravel(), -(ss * np.cos(half)).ravel()]
-    )
-    return SurfaceMesh(points, grid_cells(n_radial + 1, n_around + 1, cell_type))
+    return _revolution(s * np.sin(half), -s * np.cos(half), angle, n_around, cell_type)
 
 
 def catenoid_section(
@@ -326,11 +331,7 @@ def catenoid_section(
     """Section of a catenoid (a minimal surface: anticlastic, zero mean curvature) of waist
     radius ``waist``, ``±height/2`` along its axis (z), ``angle`` degrees around."""
     v = np.linspace(-height / 2, height / 2, n_along + 1)
-    phi = np.radians(np.linspace(-angle / 2, angle / 2, n_around + 1))
-    vv, pp = np.meshgrid(v, phi, indexing="xy")
-    r = waist * np.cosh(vv / waist)
-    points = np.column_stack([(r * np.cos(pp)).ravel(), (r * np.sin(pp)).ravel(), vv.ravel()])
-    return SurfaceMesh(points, grid_cells(n_along + 1, n_around + 1, cell_type))
+    return _revolution(waist * np.cosh(v / waist), v, angle, n_around, cell_type)
 
 
 def bumpy(

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .analysis import KEY_FIELDS
 from .io import atomic_path, field_statistics
 from .runner import JobOutcome
 
@@ -157,16 +158,7 @@ def html_report(outcome: JobOutcome) -> str:
     ]
     if fields:
         stats = field_statistics(fields)
-        for name in (
-            "det_F",
-            "warp_stretch",
-            "fill_stretch",
-            "shear_angle",
-            "warp_stress",
-            "fill_stress",
-            "stress_min",
-            "stress_max",
-        ):
+        for name in KEY_FIELDS:
             s = stats[name]
             key.append(
                 (f"{name} (min / mean / max)", f"{_g(s['min'])} / {_g(s['mean'])} / {_g(s['max'])}")
