@@ -12,7 +12,6 @@ import contextlib
 import io
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -37,14 +36,6 @@ def _listing(indices: np.ndarray, limit: int = 8) -> str:
     shown = ", ".join(str(int(i)) for i in indices[:limit])
     more = f", … ({indices.size} in all)" if indices.size > limit else ""
     return shown + more
-
-
-@dataclass(frozen=True)
-class _CellRef:
-    """Global cell numbering across cell types: cell ``k`` is ``cells[type][k - offset]``."""
-
-    cell_type: str
-    offset: int
 
 
 class SurfaceMesh:

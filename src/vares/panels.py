@@ -144,10 +144,6 @@ def split_panels(
     return panels
 
 
-def _boundary_chain_edges(mesh: SurfaceMesh) -> np.ndarray:
-    return mesh.boundary_edges()
-
-
 def find_seams(panels: list[Panel], tolerance: float | None = None) -> list[Seam]:
     """Seams between panels: chains of boundary edges whose end nodes coincide in 3D (within
     ``tolerance``; default 1e-6 × the structure's size) with a boundary edge of another panel."""
