@@ -532,7 +532,7 @@ def _align_warp(
         if new_theta != theta and new_deviation != deviation:
             slope = (new_deviation - deviation) / np.radians(new_theta - theta)
         theta, deviation = new_theta, new_deviation
-    else:
+    if abs(deviation) > _ALIGNMENT_TOLERANCE:
         raise _Failure(
             f"the warp could not be aligned with the direction (mean deviation "
             f"{np.degrees(deviation):.3g}°)",
