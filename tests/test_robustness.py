@@ -185,3 +185,12 @@ def test_solver_choice_errors(monkeypatch):
     with pytest.raises(ValueError, match="not installed"):
         get_solver("pardiso")
     assert get_solver().name == "scipy-superlu"
+
+
+@pytest.mark.parametrize("name", list(examples.EXAMPLES))
+def test_every_shipped_example_patterns_with_the_default_strategy(name):
+    mesh = examples.EXAMPLES[name]()
+    plane = examples.EXAMPLE_PLANES.get(name)
+    result = vares.solve(mesh, NEO_HOOKE, plane=plane)
+    assert result.converged, result.reason
+    assert abs(result.pattern_area / mesh.area - 1) < 0.05
