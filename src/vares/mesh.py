@@ -277,7 +277,7 @@ class SurfaceMesh:
             sizes = np.bincount(label)
             raise MeshError(
                 f"the mesh has {num_pieces} disconnected pieces (cells per piece: "
-                f"{_listing(sizes)}); pattern each piece separately"
+                f"{_listing(sizes)}); pattern each piece separately, or as panels ('vares panels')"
             )
 
         self._check_manifold_vertices(directed, owner, edge_id)
@@ -361,7 +361,10 @@ def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]
         meshes = read_3dm(path)
         if len(meshes) > 1:
             names = ", ".join(m.name for m in meshes)
-            raise MeshError(f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels")
+            raise MeshError(
+                f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels "
+                "('vares panels')"
+            )
         return meshes[0].mesh, {}
     chatter = io.StringIO()  # some readers print their complaints: keep them for the error
     try:
