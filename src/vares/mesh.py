@@ -277,7 +277,8 @@ class SurfaceMesh:
             sizes = np.bincount(label)
             raise MeshError(
                 f"the mesh has {num_pieces} disconnected pieces (cells per piece: "
-                f"{_listing(sizes)}); pattern each piece separately, or as panels ('vares panels')"
+                f"{_listing(sizes)}); pattern each piece separately (one file per panel: "
+                "'vares panels a.obj b.obj …')"
             )
 
         self._check_manifold_vertices(directed, owner, edge_id)
