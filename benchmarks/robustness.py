@@ -14,21 +14,6 @@ import time
 import vares
 from vares import examples
 
-SUITE = {
-    "hypar z = 0.06 xy, 10 m": lambda: examples.hypar(n=40),
-    "spherical cap 60°": lambda: examples.spherical_cap(half_angle=60.0, n_rings=20),
-    "hemisphere": lambda: examples.spherical_cap(half_angle=90.0, n_rings=20),
-    "deep cap 120°": lambda: examples.spherical_cap(half_angle=120.0, n_rings=20),
-    "cap R 12 m over 10 m square": lambda: examples.cap_over_square(n=40),
-    "cone segment 120°": lambda: examples.cone_segment(),
-    "catenoid section": lambda: examples.catenoid_section(),
-    "bumpy random surface": lambda: examples.bumpy(n=40),
-    "graded mesh, sizes 1:100": lambda: examples.graded_hypar(n=40),
-    "slivers, aspect 1:100": lambda: examples.graded_hypar(n=40, grading=1.0, sliver=0.01),
-    "cylinder 220°": lambda: examples.cylinder160(angle=220.0, n_around=44),
-    "rib30 (quads)": lambda: examples.rib30(cell_type="quad"),
-}
-
 
 def main() -> None:
     materials = {
@@ -40,7 +25,7 @@ def main() -> None:
         f"{'surface':<30} {'cells':>6} {'material':<12} {'ok':<3} {'start':<10} "
         f"{'iterations':>10} {'time s':>7}  strategy"
     )
-    for name, make in SUITE.items():
+    for name, make in examples.robustness_suite(fine=True).items():
         mesh = make()
         for label, material in materials.items():
             start = time.perf_counter()

@@ -100,7 +100,7 @@ def test_disconnected_pieces_are_reported():
 
 def test_pieces_touching_at_a_node_only_are_not_one_surface():
     points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], float)
-    with pytest.raises(MeshError):
+    with pytest.raises(MeshError, match="2 disconnected pieces"):
         SurfaceMesh(points, {"triangle": [[0, 1, 2], [0, 3, 4]]})
 
 

@@ -148,10 +148,17 @@ def test_split_panels_errors():
     mesh, ids = hypar_strips(strips=2, n=4)
     with pytest.raises(vares.MeshError, match="one value per cell"):
         split_panels(mesh, ids[:-1])
+    with pytest.raises(vares.MeshError, match="integers"):
+        split_panels(mesh, ids + 0.5)
     ids = ids.copy()
-    ids[0] = 7  # a single cell of panel 7 elsewhere: fine; a panel touching only at a node isn't
-    panels = split_panels(mesh, ids)
-    assert len(panels) == 3
+    ids[0] = 7  # one cell of its own: a valid panel
+    panels = split_panels(mesh, ids, {7: "patch"})
+    assert [p.name for p in panels] == ["panel-0", "panel-1", "patch"]
+    assert sum(p.mesh.num_cells for p in panels) == mesh.num_cells
+    assert panels[2].mesh.num_cells == 1
+    ids[-1] = 7  # a second, far away cell: the panel falls apart
+    with pytest.raises(vares.MeshError, match=r"panel patch: .*2 disconnected pieces"):
+        split_panels(mesh, ids, {7: "patch"})
 
 
 def test_panels_command_from_cell_data_3dm_and_files(tmp_path):

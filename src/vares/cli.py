@@ -246,8 +246,8 @@ def _vector(option: str, text: str) -> list[float]:
     return values
 
 
-def job_from_options(source: dict[str, Any], o: dict[str, Any]) -> Job:
-    """The job the command line describes."""
+def _material_section(o: dict[str, Any]) -> dict[str, Any]:
+    """The ``[material]`` section the material options describe."""
     material: dict[str, Any] = {"thickness": o["thickness"]}
     parameters = {k: o[k] for k in ("E", "nu", "mu", "E1", "E2", "G12", "nu12") if o[k] is not None}
     for key in ("A", "B", "C"):
@@ -264,6 +264,12 @@ def job_from_options(source: dict[str, Any], o: dict[str, Any]) -> Job:
             raise InputError("--presets needs --fabric")
         material["law"] = str(o["material"])
         material.update(parameters)
+    return material
+
+
+def job_from_options(source: dict[str, Any], o: dict[str, Any]) -> Job:
+    """The job the command line describes."""
+    material = _material_section(o)
     fibres: dict[str, Any] = {"warp_angle": o["warp_angle"], "orientation": str(o["orientation"])}
     if o["fill_angle"] is not None:
         fibres["fill_angle"] = o["fill_angle"]
@@ -328,13 +334,10 @@ def _progress(quiet: bool):
     return show
 
 
-_TABLE_FIELDS = KEY_FIELDS
-
-
 def _field_table(fields: dict[str, np.ndarray]) -> Table:
     table = Table("field", "min", "mean", "max", title="per-cell results (mean: area-weighted)")
     statistics = field_statistics(fields)
-    for name in _TABLE_FIELDS:
+    for name in KEY_FIELDS:
         s = statistics[name]
         table.add_row(name, f"{s['min']:.6g}", f"{s['mean']:.6g}", f"{s['max']:.6g}")
     return table
@@ -531,36 +534,7 @@ def evaluate(
     """
 
     def body() -> None:
-        defaults = {
-            k: None
-            for k in (
-                "warp_direction",
-                "prestress",
-                "prestress_field",
-                "plane",
-                "linear_solver",
-                "mark_spacing",
-                "name",
-            )
-        }
-        job = job_from_options(
-            {"mesh": str(surface.resolve())},
-            {
-                **defaults,
-                **options,
-                "orientation": "held",
-                "slack_threshold": 0.0,
-                "strategy": "auto",
-                "steps": 3,
-                "tolerance": 1e-10,
-                "max_iterations": 50,
-                "report": False,
-                "units": "m",
-                "dxf_units": "mm",
-                "allowance": 0.0,
-            },
-        )
-        material = build_material(job)
+        material = build_material(Job(material=_material_section(options)))
         mesh = read_mesh(surface)
         coordinates = read_pattern(pattern_file, mesh)
         output = options["output"]

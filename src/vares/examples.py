@@ -40,6 +40,7 @@ __all__ = [
     "hypar",
     "hypar_strips",
     "rib30",
+    "robustness_suite",
     "spherical_cap",
 ]
 
@@ -398,6 +399,35 @@ def hypar_strips(
     centroid_x = np.concatenate([mesh.points[c][:, :, 0].mean(axis=1) for c in mesh.cells.values()])
     ids = np.clip(((centroid_x + size / 2) / (size / strips)).astype(int), 0, strips - 1)
     return mesh, ids
+
+
+def robustness_suite(fine: bool = False) -> dict[str, Callable[[], SurfaceMesh]]:
+    """The shipped set of hard and awkward surfaces every strategy change is checked on: steep
+    and folding shapes, doubly curved ones of both signs, random bumps, graded cells and
+    slivers. ``fine`` gives the meshes of ``benchmarks/robustness.py``, else smaller ones."""
+    n, rings = (40, 20) if fine else (12, 8)
+    return {
+        "hypar z = 0.06 xy, 10 m": lambda: hypar(n=n),
+        "spherical cap 60°": lambda: spherical_cap(half_angle=60.0, n_rings=rings),
+        "hemisphere": lambda: spherical_cap(half_angle=90.0, n_rings=rings),
+        "deep cap 120°": lambda: spherical_cap(half_angle=120.0, n_rings=rings),
+        "cap R 12 m over 10 m square": lambda: cap_over_square(n=n),
+        "cone segment 120°": lambda: cone_segment(
+            n_radial=12 if fine else 6, n_around=24 if fine else 12
+        ),
+        "catenoid section": lambda: catenoid_section(
+            n_along=16 if fine else 8, n_around=24 if fine else 12
+        ),
+        "bumpy random surface": lambda: bumpy(n=n if fine else 16),
+        "graded mesh, sizes 1:100": lambda: graded_hypar(n=n),
+        "slivers, aspect 1:100": lambda: graded_hypar(n=n, grading=1.0, sliver=0.01),
+        "cylinder 220°": lambda: cylinder160(
+            angle=220.0, n_around=44 if fine else 22, n_along=16 if fine else 4
+        ),
+        "rib30 (quads)": lambda: rib30(
+            cell_type="quad", **({} if fine else {"spacing": 0.02, "fillet_segments": 3})
+        ),
+    }
 
 
 #: Example generators by name (used by ``vares example``).

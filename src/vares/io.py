@@ -98,7 +98,8 @@ def write_surface(
             for name, values in fields.items()
         }
     out = meshio.Mesh(points, blocks, cell_data=cell_data)
-    _write_with(Path(path), lambda p: meshio.write(p, out, file_format=_meshio_format(path)))
+    # the temporary file keeps the suffix, from which meshio takes the format
+    _write_with(Path(path), lambda p: meshio.write(p, out))
 
 
 def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
@@ -127,11 +128,6 @@ def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
     if points.shape[1] == 3 and np.abs(points[:, 2]).max(initial=0.0) > 1e-9 * np.ptp(points):
         raise MeshError(f"{path} is not flat (z ≠ 0): not a pattern")
     return points[:, :2].copy()
-
-
-def _meshio_format(path: Path) -> str | None:
-    suffix = Path(path).suffix.lower()
-    return {".obj": "obj", ".vtu": "vtu", ".ply": "ply", ".stl": "stl", ".vtk": "vtk"}.get(suffix)
 
 
 def write_json(path: Path, data: dict) -> None:

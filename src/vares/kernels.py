@@ -28,7 +28,7 @@ from numba import njit
 from .elements import ReferenceElement
 from .materials import Fibres, Hyperelastic
 
-__all__ = ["BlockResult", "block_energy", "determinant", "inverse"]
+__all__ = ["BlockResult", "block_energy", "determinant", "inverse", "projected_hessian"]
 
 _EYE = np.eye(2)
 
@@ -53,12 +53,15 @@ def inverse(a: np.ndarray, det: np.ndarray | None = None) -> np.ndarray:
 class BlockResult:
     """Per-cell contributions of one cell block.
 
-    ``energy`` ``(m,)``; ``gradient`` ``(m, nen, 2)``; ``hessian`` ``(m, nen, 2, nen, 2)`` or None.
+    ``energy`` ``(m,)``; ``gradient`` ``(m, nen, 2)``; ``hessian`` ``(m, nen, 2, nen, 2)`` or None;
+    ``jacobian_hessian`` ``(m, q, 4, 4)``: ``∂²W/∂J²`` at each quadrature point, from which
+    :func:`projected_hessian` makes a positive semi-definite tangent without recomputing.
     """
 
     energy: np.ndarray
     gradient: np.ndarray | None
     hessian: np.ndarray | None
+    jacobian_hessian: np.ndarray | None = None
 
 
 def block_energy(
@@ -71,7 +74,6 @@ def block_energy(
     fibres: Fibres | None = None,
     prestress: np.ndarray | None = None,
     order: int = 2,
-    projected: bool = False,
 ) -> BlockResult:
     """Energy (and gradient for ``order ≥ 1``, Hessian for ``order = 2``) of a block of cells.
 
@@ -87,10 +89,6 @@ def block_energy(
         The law, the thickness (energy per area = thickness × Ψ) and the fibre directions.
     prestress
         Second Piola–Kirchhoff prestress in the pattern frame, broadcastable to ``(m, q, 2, 2)``.
-    projected
-        Return the Hessian with the negative eigenvalues of each quadrature point's ``∂²W/∂J²``
-        set to zero: positive semi-definite, for Newton steps far from the solution (real
-        arithmetic only).
 
     The caller ensures ``det J > 0`` (see :meth:`vares.problem.Problem.inverted_cells`).
     """
@@ -124,10 +122,21 @@ def block_energy(
     )
     if order < 2:
         return BlockResult(energy, gradient, None)
-    if projected:
-        _project_psd(jacobian_hessian)
     shape_gradients = np.ascontiguousarray(element.shape_gradients, dtype=dtype)
-    return BlockResult(energy, gradient, _nodal_hessian(jacobian_hessian, shape_gradients, scale))
+    hessian = _nodal_hessian(jacobian_hessian, shape_gradients, scale)
+    return BlockResult(energy, gradient, hessian, jacobian_hessian)
+
+
+def projected_hessian(
+    element: ReferenceElement, jacobian_hessian: np.ndarray, thickness: float
+) -> np.ndarray:
+    """Nodal Hessian ``(m, nen, 2, nen, 2)`` with the negative eigenvalues of every quadrature
+    point's ``∂²W/∂J²`` set to zero: positive semi-definite, for Newton steps far from the
+    solution (real arithmetic only)."""
+    projected = jacobian_hessian.copy()
+    _project_psd(projected)
+    scale = thickness * element.quadrature_weights
+    return _nodal_hessian(projected, np.ascontiguousarray(element.shape_gradients), scale)
 
 
 @njit(cache=True)

@@ -7,12 +7,12 @@ it knows nothing about how the pattern is found (see :mod:`vares.solver`).
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .elements import ELEMENTS
-from .kernels import block_energy, determinant
+from .kernels import block_energy, determinant, projected_hessian
 from .materials import Fibres, Hyperelastic, MaterialError
 from .mesh import SurfaceMesh
 from .prestress import prestress_components, prestress_tensor
@@ -28,6 +28,7 @@ class Evaluation:
     cell_energy: list[np.ndarray]
     gradients: list[np.ndarray] | None
     hessians: list[np.ndarray] | None
+    jacobian_hessians: list[np.ndarray] | None = None
 
 
 class Problem:
@@ -117,9 +118,9 @@ class Problem:
 
         ``coordinates`` is the pattern ``(n, 2)``; it must not invert any cell. With
         ``projected`` the Hessians are made positive semi-definite quadrature point by
-        quadrature point (see :func:`vares.kernels.block_energy`).
+        quadrature point (see :meth:`projected_hessians`).
         """
-        energies, gradients, hessians = [], [], []
+        energies, gradients, hessians, jacobian_hessians = [], [], [], []
         for (cell_type, cells), metric, prestress in zip(
             self.mesh.cells.items(), self._metrics, self._prestress_blocks, strict=True
         ):
@@ -132,18 +133,30 @@ class Problem:
                 fibres=self.fibres,
                 prestress=prestress,
                 order=order,
-                projected=projected,
             )
             energies.append(block.energy)
             gradients.append(block.gradient)
             hessians.append(block.hessian)
+            jacobian_hessians.append(block.jacobian_hessian)
         total = float(sum(np.sum(e).real for e in energies))
-        return Evaluation(
+        evaluation = Evaluation(
             total,
             energies,
             gradients if order >= 1 else None,
             hessians if order >= 2 else None,
+            jacobian_hessians if order >= 2 else None,
         )
+        if projected and order >= 2:
+            evaluation = replace(evaluation, hessians=self.projected_hessians(evaluation))
+        return evaluation
+
+    def projected_hessians(self, evaluation: Evaluation) -> list[np.ndarray]:
+        """The per-block Hessians of an (order 2) evaluation made positive semi-definite point by
+        point (projected Newton), from its stored ``∂²W/∂J²``: nothing is evaluated again."""
+        return [
+            projected_hessian(ELEMENTS[t], h, self.thickness)
+            for t, h in zip(self.mesh.cells, evaluation.jacobian_hessians, strict=True)
+        ]
 
     def energy(self, coordinates: np.ndarray) -> float:
         """Energy of a pattern; ``inf`` when it inverts a cell."""

@@ -295,9 +295,8 @@ def _newton(
             and not converged
             and residual >= _EXACT_TANGENT_BELOW * ctx.force_scale
         )
-        if projected:
-            evaluation = problem.evaluate(x, order=2, projected=True)
-        matrix = None if converged else ctx.assembler.matrix(evaluation.hessians)
+        hessians = problem.projected_hessians(evaluation) if projected else evaluation.hessians
+        matrix = None if converged else ctx.assembler.matrix(hessians)
         if method == "damped" and matrix is not None:
             scale = damping * float(np.mean(np.abs(matrix.diagonal())))
             cap = scale * min(1.0, residual / initial_residual) if initial_residual > 0 else scale
@@ -363,8 +362,7 @@ def _newton(
         for attempt in ("projected",) if projected else ("exact", "projected"):
             if attempt == "projected" and not projected:
                 projected = True
-                hessians = problem.evaluate(x, order=2, projected=True).hessians
-                matrix = ctx.assembler.matrix(hessians)
+                matrix = ctx.assembler.matrix(problem.projected_hessians(evaluation))
             try:
                 delta = ctx.step(matrix, -residual_vector)
             except SingularMatrixError:
