@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from vares.batch import run_batch
+from vares.app.batch import run_batch
 
 
 def write_jobs(folder: Path, count: int) -> list[Path]:

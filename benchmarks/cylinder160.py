@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 import vares
-from vares.examples import cylinder160, cylinder_arc_length
+from vares.geometry.examples import cylinder160, cylinder_arc_length
 
 
 def main() -> None:

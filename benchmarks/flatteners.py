@@ -121,7 +121,7 @@ def run_method(surface: str, triangles: int, method: str, solver: str | None, ou
 
 def judge(mesh, pattern: np.ndarray) -> dict[str, float]:
     import vares
-    from vares.problem import Problem
+    from vares.mechanics import Problem
 
     material = vares.materials.StVenantKirchhoff(1000.0, 0.3)
     problem = Problem(mesh, material)

@@ -17,10 +17,8 @@ import time
 import numpy as np
 
 import vares
-from vares.assembly import Assembler
-from vares.linalg import available_solvers, get_solver
-from vares.problem import Problem
-from vares.solver import _rigid_modes
+from vares.mechanics import Assembler, Problem, rigid_modes
+from vares.solver.linear import available_solvers, get_solver
 
 
 def best_of(repeat: int, func):
@@ -49,8 +47,8 @@ def main() -> None:
 
     small = vares.examples.hypar(n=3, cell_type=args.cell_type)  # load compiled code first
     Problem(small, material).evaluate(small.points[:, :2])
-    Assembler(small, _rigid_modes(small.points[:, :2], "fixed")[0])
-    setup, assembler = best_of(1, lambda: Assembler(mesh, _rigid_modes(x, "fixed")[0]))
+    Assembler(small, rigid_modes(small.points[:, :2], "fixed")[0])
+    setup, assembler = best_of(1, lambda: Assembler(mesh, rigid_modes(x, "fixed")[0]))
     kernel, evaluation = best_of(args.repeat, lambda: problem.evaluate(x, order=2))
     vector, residual = best_of(args.repeat, lambda: assembler.vector(evaluation.gradients))
     matrix_time, matrix = best_of(args.repeat, lambda: assembler.matrix(evaluation.hessians))

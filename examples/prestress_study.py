@@ -15,9 +15,9 @@ import time
 from pathlib import Path
 
 import vares
-from vares.compensation import compensation_report
-from vares.examples import conic_tent, four_point_sail
-from vares.plot import save_pattern_figure
+from vares.analysis import compensation_report
+from vares.geometry.examples import conic_tent, four_point_sail
+from vares.io.plot import save_pattern_figure
 
 PRESTRESS = (2.0, 1.5)
 

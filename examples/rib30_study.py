@@ -22,8 +22,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import vares
-from vares.examples import rib30
-from vares.plot import plot_pattern, save_pattern_figure
+from vares.geometry.examples import rib30
+from vares.io.plot import plot_pattern, save_pattern_figure
 
 RIB_AXIS = (0.0, 1.0, 0.0)
 BIAS = (-1.0, 1.0, 0.0)

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from vares.batch import is_complete, run_batch
-from vares.cli import app
-from vares.job import load_job
+from vares.app.batch import is_complete, run_batch
+from vares.app.cli import app
+from vares.app.job import load_job
 
 runner = CliRunner()
 

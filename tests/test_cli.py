@@ -6,8 +6,8 @@ import pytest
 from typer.testing import CliRunner
 
 import vares
-from vares.cli import app
-from vares.examples import cylinder160, cylinder_arc_length, hypar
+from vares.app.cli import app
+from vares.geometry.examples import cylinder160, cylinder_arc_length, hypar
 
 runner = CliRunner()
 
@@ -112,7 +112,7 @@ def test_missing_file_and_bad_options(tmp_path):
     result = run("example", "cylinder160", "-o", tmp_path / "o", "--nu", 0.7)
     assert result.exit_code == 2 and "Poisson" in error_line(result)
     result = run("example", "sphere", "-o", tmp_path / "o")
-    assert result.exit_code == 2 and "unknown example" in error_line(result)
+    assert result.exit_code == 2 and "--example must be one of cylinder160" in error_line(result)
     result = run("example", "cylinder160", "-o", tmp_path / "o", "--plane", "1,a,0")
     assert result.exit_code == 2 and "--plane" in error_line(result)
 
@@ -368,7 +368,7 @@ def test_prestress_field_option(tmp_path):
     result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "mystery")
     assert result.exit_code == 2 and "unknown fabric preset" in error_line(result)
     result = run("pattern", source, "-o", tmp_path / "x", "--fabric", "pes-pvc-type-2", "--E1", 5)
-    assert result.exit_code == 2 and "--fabric sets the material" in error_line(result)
+    assert result.exit_code == 2 and "a fabric preset sets the material" in error_line(result)
 
 
 def test_fabrics_lists_the_presets():

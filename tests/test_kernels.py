@@ -3,9 +3,7 @@
 import numpy as np
 import pytest
 
-from vares.assembly import Assembler
-from vares.elements import ELEMENTS
-from vares.kernels import block_energy
+from vares.geometry.elements import ELEMENTS
 from vares.materials import (
     Fibres,
     IncompressibleNeoHooke,
@@ -14,7 +12,8 @@ from vares.materials import (
     OrthotropicStVenantKirchhoff,
     StVenantKirchhoff,
 )
-from vares.problem import Problem
+from vares.mechanics import Assembler, Problem
+from vares.mechanics.kernels import block_energy
 
 LAWS = [
     StVenantKirchhoff(E=10.0, nu=0.3),

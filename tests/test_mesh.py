@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from vares import MeshError, SurfaceMesh, read_mesh
-from vares.examples import cylinder160, grid_cells, hypar
+from vares.geometry.examples import cylinder160, grid_cells, hypar
 
 SQUARE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
 

@@ -4,18 +4,9 @@ import numpy as np
 import pytest
 
 import vares
-from vares.assembly import Assembler
-from vares.examples import grid_cells, hypar_strips
-from vares.panels import (
-    Panel,
-    _Coupled,
-    _kkt,
-    find_seams,
-    roll_width_check,
-    solve_structure,
-    split_panels,
-)
-from vares.solver import _rigid_modes
+from vares.geometry.examples import grid_cells, hypar_strips
+from vares.structures import Panel, find_seams, solve_structure, split_panels
+from vares.structures.matching import CoupledProblem
 
 FABRIC = vares.materials.fabric("pes-pvc-type-2").material()
 
@@ -84,14 +75,8 @@ def test_coupled_residual_and_tangent_by_finite_differences(strips):
     panels = strips[:2]
     results = [vares.solve(p.mesh, FABRIC, warp_angle=10.0) for p in panels]
     seams = find_seams(panels)
-    problems, assemblers, rotations = [], [], []
-    for r in results:
-        problems.append(vares.Problem(r.mesh, FABRIC, fibres=r.fibres))
-        free, rotation = _rigid_modes(r.material_coordinates, "held")
-        assemblers.append(Assembler(r.mesh, free))
-        rotations.append(rotation)
-    offsets = np.concatenate([[0], np.cumsum([a.num_free for a in assemblers])])
-    coupled = _Coupled(problems, assemblers, rotations, offsets, seams)
+    coupled = CoupledProblem.build(results, FABRIC, 1.0, seams)
+    assert coupled.num_rotations == 2  # anisotropic, rotation held: one row per panel
     rng = np.random.default_rng(0)
     x = [
         r.material_coordinates + 1e-3 * rng.normal(size=r.material_coordinates.shape)
@@ -99,18 +84,19 @@ def test_coupled_residual_and_tangent_by_finite_differences(strips):
     ]
     count = 2 + sum(s.segments for s in seams)
     lam = rng.normal(size=count)
-    gradient, _, matrix, _, b = _kkt(coupled, x, lam)
+    gradient, _, matrix, _ = coupled.kkt(x, lam)
     n = coupled.num_free
     matrix = matrix.toarray()
+    b = matrix[n:, :n]
 
     def lagrangian(coords):
-        _, c, _, e, _ = _kkt(coupled, coords, np.zeros(count))
+        _, c, _, e = coupled.kkt(coords, np.zeros(count))
         return e + lam @ c
 
     def shifted(dof, h):
         coords = [c.copy() for c in x]
         for p in range(2):
-            index = coupled.free_index(p)
+            index = coupled.free_index[p].ravel()
             hit = np.flatnonzero(index == dof)
             if hit.size:
                 coords[p].ravel()[hit[0]] += h
@@ -124,21 +110,26 @@ def test_coupled_residual_and_tangent_by_finite_differences(strips):
         fd = (lagrangian(up) - lagrangian(down)) / (2 * h)
         # the rotation rows are linear in the displacement from the start: their value is not
         # part of c(X) above, but their gradient is, so compare without them
-        rotation_part = b.toarray()[rotation_rows, dof] @ lam[rotation_rows]
+        rotation_part = b[rotation_rows, dof] @ lam[rotation_rows]
         assert gradient[dof] - rotation_part == pytest.approx(fd, abs=1e-6)
-        g_up = _kkt(coupled, up, lam)[0]
-        g_down = _kkt(coupled, down, lam)[0]
+        g_up = coupled.kkt(up, lam).gradient
+        g_down = coupled.kkt(down, lam).gradient
         np.testing.assert_allclose(matrix[:n, dof], (g_up - g_down) / (2 * h), atol=1e-5)
-        c_up, c_down = _kkt(coupled, up, lam)[1], _kkt(coupled, down, lam)[1]
+        c_up, c_down = coupled.kkt(up, lam).constraint, coupled.kkt(down, lam).constraint
         np.testing.assert_allclose(matrix[n + 2 :, dof], ((c_up - c_down) / (2 * h))[2:], atol=1e-7)
 
 
 def test_roll_width_check(strips):
-    structure = solve_structure(strips, FABRIC, match_seams=False, warp_direction=(0, 1, 0))
     names = [p.name for p in strips]
+    wide = solve_structure(
+        strips, FABRIC, match_seams=False, warp_direction=(0, 1, 0), roll_width=10.0
+    )
+    assert wide.too_wide == []
+    structure = solve_structure(
+        strips, FABRIC, match_seams=False, warp_direction=(0, 1, 0), roll_width=1.6
+    )
     lengths = [np.ptp(r.material_coordinates[:, 0]) for r in structure.results]
-    assert roll_width_check(structure.results, names, 10.0) == []
-    too_narrow = roll_width_check(structure.results, names, 1.6)
+    too_narrow = structure.too_wide
     assert [name for name, _ in too_narrow] == names  # strips are about 1.7 m wide
     assert all(w == pytest.approx(1.7, abs=0.02) for _, w in too_narrow)
     assert min(lengths) > 9.9  # the warp (+x in the pattern) runs along the strips
@@ -167,8 +158,8 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
     import meshio
     from typer.testing import CliRunner
 
-    from vares.cli import app
-    from vares.rhino import NamedMesh, write_3dm
+    from vares.app.cli import app
+    from vares.io.rhino import NamedMesh, write_3dm
 
     runner = CliRunner()
     mesh, ids = hypar_strips(strips=3, cells_per_strip=3, n=9)
@@ -232,3 +223,127 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
     assert result.exit_code == 0, result.stderr
     result = runner.invoke(app, ["panels", str(files[0]), "-o", str(tmp_path / "one")])
     assert result.exit_code == 2 and "panel ids" in result.stderr
+
+
+def _cli(*args):
+    from typer.testing import CliRunner
+
+    from vares.app.cli import app
+
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def test_the_iteration_limit_holds_for_every_panel_solve_and_the_matching(tmp_path):
+    import json
+
+    result = _cli(
+        "panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 2, "-q"
+    )
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((tmp_path / "structure.json").read_text())
+    assert data["converged"] and 1 <= data["coupled_iterations"] <= 2
+    assert data["options"]["max_iterations"] == 2
+    for panel in data["panels"]:
+        summary = json.loads((tmp_path / panel["name"] / "summary.json").read_text())
+        assert summary["options"]["max_iterations"] == 2
+        assert summary["converged"] and all(s["iterations"] <= 2 for s in summary["steps"])
+    # with the default limit the same panels take 3 iterations in their first step
+    structure = solve_structure(split_panels(*hypar_strips()), vares.materials.NeoHooke(1e3, 0.3))
+    assert max(r.steps[0].iterations for r in structure.results) == 3
+
+
+def test_a_structure_whose_matching_fails_says_so_everywhere(tmp_path, monkeypatch):
+    import json
+
+    from vares.structures import matching
+
+    monkeypatch.setattr(matching, "ROUND_OFF", 0)  # seams can never match: the limit is hit
+    mesh, ids = hypar_strips(strips=3, n=8)
+    structure = solve_structure(split_panels(mesh, ids), FABRIC, max_iterations=3)
+    assert not structure.converged and structure.matched
+    assert structure.reason == "seam matching: iteration limit (3) reached"
+    assert structure.iterations == 3
+    assert all(not r.converged and r.reason == structure.reason for r in structure.results)
+    result = _cli("panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 3)
+    assert result.exit_code == 1
+    error = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert error == [
+        "vares: error: the structure did not converge: seam matching: iteration limit (3) reached"
+    ]
+    data = json.loads((tmp_path / "structure.json").read_text())
+    assert data["converged"] is False and data["reason"] == structure.reason
+    assert [p["converged"] for p in data["panels"]] == [False] * 6
+    for panel in data["panels"]:
+        summary = json.loads((tmp_path / panel["name"] / "summary.json").read_text())
+        assert summary["converged"] is False and summary["reason"] == structure.reason
+        assert not (tmp_path / panel["name"] / "pattern.dxf").exists()
+    assert not (tmp_path / "structure.dxf").exists()
+
+
+@pytest.mark.parametrize("prestressed", [False, True])
+def test_ten_strips_with_seams_through_cells_match_quadratically(prestressed):
+    from vares.geometry.examples import irregular_hypar_strips
+
+    mesh, ids = irregular_hypar_strips(strips=10, seed=3)
+    panels = split_panels(mesh, ids)
+    seams = find_seams(panels)
+    assert len(panels) == 10 and len(seams) == 9
+    segments = np.concatenate(
+        [
+            np.linalg.norm(np.diff(panels[s.first].mesh.points[s.nodes_first], axis=0), axis=1)
+            for s in seams
+        ]
+    )
+    assert segments.min() < 0.05 * segments.mean()  # short segments, as a cut through cells makes
+    settings = {"warp_direction": (0, 1, 0), "prestress": (2.0, 1.5)} if prestressed else {}
+    material = FABRIC if prestressed else vares.materials.NeoHooke(1e3, 0.3)
+    structure = solve_structure(panels, material, seams=seams, **settings)
+    assert structure.converged, structure.reason
+    assert structure.iterations <= 5
+    assert max(r.max_segment_mismatch_after for r in structure.seam_reports) < 1e-9
+    assert max(r.mismatch_before for r in structure.seam_reports) > 1e-5
+    violations = [h.violation for h in structure.history]
+    assert violations[2] < 1e-3 * violations[1]  # quadratic, not linear, convergence
+
+
+def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved_job(tmp_path):
+    import json
+
+    import meshio
+
+    mesh, ids = hypar_strips(strips=2, cells_per_strip=2, n=6)
+    source = tmp_path / "sail.vtu"
+    cells = [("triangle", mesh.cells["triangle"])]
+    meshio.write(source, meshio.Mesh(mesh.points, cells, cell_data={"panel": [ids]}))
+    out, saved = tmp_path / "out", tmp_path / "jobs" / "sail.toml"
+    result = _cli(
+        "panels", source, "-o", out, "--report", "--plot", "det_F", "--save-job", saved, "-q"
+    )
+    assert result.exit_code == 0, result.stderr
+    single = _cli("pattern", source, "-o", tmp_path / "single", "--plot", "det_F", "-q")
+    assert single.exit_code == 0, single.stderr
+    expected = {p.name for p in (tmp_path / "single").iterdir()} | {"surface.obj", "report.html"}
+    names = ["panel-0", "panel-1"]
+    for name in names:
+        assert {p.name for p in (out / name).iterdir()} == expected
+    assert {p.name for p in out.iterdir()} == {
+        *names,
+        "structure.json",
+        "structure.dxf",
+        "report.html",
+    }
+    report = (out / "report.html").read_text()
+    assert all(f'href="{name}/report.html"' in report for name in names)
+    # the saved job names its input and output relative to itself, and reruns elsewhere
+    text = saved.read_text()
+    assert (
+        'mesh = "../sail.vtu"' in text and 'directory = "../out"' in text and "[structure]" in text
+    )
+    moved = tmp_path / "moved"
+    result = _cli("run", saved, "-o", moved, "-q")
+    assert result.exit_code == 0, result.stderr
+    first = json.loads((out / "structure.json").read_text())
+    again = json.loads((moved / "structure.json").read_text())
+    assert again["energy"] == first["energy"] and again["converged"]
+    result = _cli("run", saved, "-q")  # the job's own folder exists: nothing is overwritten
+    assert result.exit_code == 2 and "output exists" in result.stderr

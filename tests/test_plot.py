@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 
 import vares
-from vares.analysis import FIELD_DESCRIPTIONS
-from vares.examples import hypar
-from vares.plot import FIELD_LABELS, plot_pattern, save_pattern_figure
+from vares.geometry.examples import hypar
+from vares.io.plot import FIELD_LABELS, plot_pattern, save_pattern_figure
+from vares.mechanics.fields import FIELD_DESCRIPTIONS
 
 
 def test_every_field_has_a_colour_bar_label():

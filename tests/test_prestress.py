@@ -7,9 +7,8 @@ from conftest import rotation
 from scipy.optimize import root
 
 import vares
-from vares.assembly import Assembler
-from vares.compensation import compensation_report
-from vares.examples import conic_tent, four_point_sail, grid_cells
+from vares.analysis import compensation_report
+from vares.geometry.examples import conic_tent, four_point_sail, grid_cells
 from vares.materials import (
     Fibres,
     MaterialError,
@@ -20,7 +19,8 @@ from vares.materials import (
     load_presets,
     presets,
 )
-from vares.prestress import PrestressWarning, prestress_components
+from vares.mechanics import Assembler
+from vares.mechanics.prestress import PrestressWarning, prestress_components
 
 
 # ---- closed form: a flat rectangle with uniform biaxial prestress ---------------------------

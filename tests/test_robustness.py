@@ -6,10 +6,10 @@ import scipy.sparse as sp
 
 import vares
 from vares import examples
-from vares.initial import lscm, projection_distortion
-from vares.linalg import SingularMatrixError, available_solvers, get_solver
+from vares.geometry.flatten import lscm, projection_distortion
 from vares.materials import NeoHooke, NonCrimpFabric, OrthotropicStVenantKirchhoff
-from vares.solver import _step_bound
+from vares.solver import linear
+from vares.solver.linear import SingularMatrixError, available_solvers, get_solver
 
 NEO_HOOKE = NeoHooke(1000.0, 0.3)
 ORTHO = OrthotropicStVenantKirchhoff(800.0, 640.0, 40.0, 0.4)
@@ -104,7 +104,7 @@ def test_step_bound_stops_at_the_first_collapsing_cell():
     problem = vares.Problem(mesh, NEO_HOOKE)
     rng = np.random.default_rng(2)
     direction = rng.normal(size=x.shape)
-    bound = _step_bound(problem, x, direction)
+    bound = problem.admissible_step(x, direction)
     assert 0 < bound < np.inf
     assert problem.inverted_cells(x + 0.999 * bound * direction).size == 0
     assert problem.inverted_cells(x + 1.001 * bound * direction).size > 0
@@ -167,7 +167,7 @@ def test_singular_matrices_are_reported():
 def test_solver_choice_errors(monkeypatch):
     with pytest.raises(ValueError, match="unknown linear solver"):
         get_solver("gauss")
-    monkeypatch.setattr(vares.linalg, "_importable", lambda module: False)
+    monkeypatch.setattr(linear, "_importable", lambda module: False)
     assert available_solvers() == ["scipy-superlu"]
     with pytest.raises(ValueError, match="not installed"):
         get_solver("pardiso")

@@ -8,34 +8,55 @@ stores the least elastic energy (minus the work of the intended prestress).
 >>> result = vares.solve(mesh, vares.materials.NeoHooke(E=1000.0, nu=0.3))
 >>> result.converged
 True
+
+The package is layered along the data path (docs/architecture.md): ``materials`` and
+``geometry`` → ``mechanics`` → ``solver`` → ``analysis`` → ``structures`` → ``io`` → ``app``.
 """
 
-from . import examples, materials
-from .analysis import PatternEvaluation, cell_fields, evaluate
-from .initial import ProjectionPlane, projection_plane
+from . import materials
+from ._version import __version__
+from .analysis import PatternEvaluation, cell_fields, compensation_report, evaluate
+from .geometry import MeshError, ProjectionPlane, SurfaceMesh, examples, projection_plane
+from .io import read_mesh, read_mesh_data
 from .materials import Fibres
-from .mesh import MeshError, SurfaceMesh, read_mesh, read_mesh_data
-from .problem import Problem
-from .solver import IterationRecord, PatternResult, StepRecord, solve
-
-__version__ = "0.1.0"
+from .mechanics import Problem
+from .options import OptionsError
+from .solver import IterationRecord, PatternResult, SolveOptions, StepRecord, solve
+from .structures import (
+    Panel,
+    StructureOptions,
+    StructureResult,
+    find_seams,
+    solve_structure,
+    split_panels,
+)
 
 __all__ = [
     "Fibres",
     "IterationRecord",
     "MeshError",
+    "OptionsError",
+    "Panel",
     "PatternEvaluation",
     "PatternResult",
     "Problem",
     "ProjectionPlane",
+    "SolveOptions",
     "StepRecord",
+    "StructureOptions",
+    "StructureResult",
     "SurfaceMesh",
+    "__version__",
     "cell_fields",
+    "compensation_report",
     "evaluate",
     "examples",
+    "find_seams",
     "materials",
     "projection_plane",
     "read_mesh",
     "read_mesh_data",
     "solve",
+    "solve_structure",
+    "split_panels",
 ]

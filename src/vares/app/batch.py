@@ -1,0 +1,138 @@
+"""Batches: many independent jobs, on local worker processes or on a Dask cluster.
+
+Each job file runs as :func:`vares.app.runner.run_job` would run it alone, so the results do not
+depend on where it ran. A failing job is reported and does not stop the others. A job whose
+``summary.json`` (``structure.json`` for a structure) is complete — converged, and written for the
+same job (the job's digest is stored in it) — is skipped, so an interrupted batch resumes where it
+stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass
+from multiprocessing import get_context
+from pathlib import Path
+
+from .job import Job, load_job
+from .runner import run_job
+
+__all__ = ["JobStatus", "is_complete", "run_batch", "run_job_file"]
+
+
+@dataclass(frozen=True)
+class JobStatus:
+    """How one job of a batch ended: ``done``, ``skipped``, ``failed`` or ``not converged``."""
+
+    job: str
+    status: str
+    message: str
+    seconds: float
+    output: str
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _summary_path(job: Job) -> Path:
+    return job.directory / ("summary.json" if job.structure is None else "structure.json")
+
+
+def is_complete(job: Job) -> bool:
+    """True when the job's outputs exist, converged, and were written for this very job."""
+    path = _summary_path(job)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return bool(data.get("converged")) and data.get("job_digest") == job.digest()
+
+
+def _limit_threads(threads: int) -> None:
+    """Keep each worker's numerical libraries to its share of the cores."""
+    for variable in (
+        "MKL_NUM_THREADS",
+        "OMP_NUM_THREADS",
+        "OPENBLAS_NUM_THREADS",
+        "NUMBA_NUM_THREADS",
+    ):
+        os.environ[variable] = str(threads)
+
+
+def run_job_file(path: str, force: bool = False) -> JobStatus:
+    """Run one job file (in whatever process calls this); never raises."""
+    started = time.perf_counter()
+    output = ""
+    try:
+        job = load_job(path)
+        output = str(_summary_path(job).parent)
+        if not force and is_complete(job):
+            return JobStatus(str(path), "skipped", "complete", 0.0, output)
+        outcome = run_job(job, force=True)
+        status = "done" if outcome.converged else "not converged"
+        iterations = sum(p.result.iterations for p in outcome.panels)
+        energy = sum(p.result.energy for p in outcome.panels)
+        message = (
+            f"{iterations} iterations, energy {energy:.6e}"
+            if outcome.converged
+            else str(outcome.reason)
+        )
+        return JobStatus(str(path), status, message, time.perf_counter() - started, output)
+    except Exception as exc:  # a failing job is reported, the batch goes on
+        return JobStatus(
+            str(path),
+            "failed",
+            f"{type(exc).__name__}: {exc}",
+            time.perf_counter() - started,
+            output,
+        )
+
+
+def run_batch(
+    paths: Sequence[str | Path],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    force: bool = False,
+    callback: Callable[[JobStatus], None] | None = None,
+) -> list[JobStatus]:
+    """Run job files in parallel: ``workers`` local processes (default: one per core), or the
+    workers of the Dask distributed scheduler at ``scheduler`` (``tcp://host:port``).
+
+    Returns one :class:`JobStatus` per job, in the order given; ``callback`` sees each as it ends.
+    """
+    paths = [str(Path(p).resolve()) for p in paths]
+    if not paths:
+        return []
+    statuses: dict[str, JobStatus] = {}
+
+    def finished(status: JobStatus) -> None:
+        statuses[status.job] = status
+        if callback is not None:
+            callback(status)
+
+    if scheduler is not None:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+
+        with Client(scheduler, timeout="20s") as client:
+            futures = client.map(run_job_file, paths, force=force, pure=False)
+            for future in dask_completed(futures):
+                finished(future.result())
+    else:
+        workers = max(1, workers or os.cpu_count() or 1)
+        threads = max(1, (os.cpu_count() or 1) // workers)
+        with ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=get_context("spawn"),
+            initializer=_limit_threads,
+            initargs=(threads,),
+        ) as pool:
+            futures = [pool.submit(run_job_file, path, force) for path in paths]
+            for future in as_completed(futures):
+                finished(future.result())
+    return [statuses[path] for path in paths]

@@ -1,0 +1,185 @@
+"""What every command shares: the console, one-line errors and exit codes, running a job and
+showing what it did."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from ...analysis.statistics import field_statistics
+from ...geometry.mesh import MeshError
+from ...io.files import OutputExistsError, atomic_path, check_writable
+from ...materials import MaterialError
+from ...mechanics.fields import KEY_FIELDS
+from ...options import OptionsError
+from ...solver.result import IterationRecord
+from ..job import Job, JobError
+from ..outcome import JobOutcome, PanelOutcome
+from ..runner import run_job
+from .flags import InputError
+
+__all__ = ["console", "execute", "fail", "field_table", "guarded"]
+
+console = Console(stderr=True, highlight=False, soft_wrap=True)
+
+
+def fail(message: str, code: int) -> int:
+    """Print ``vares: error: message``; return the exit code."""
+    console.print(f"vares: error: {message}", markup=False)
+    return code
+
+
+def guarded(body: Callable[[], None]) -> None:
+    """Run a command body, turning known errors into one-line messages and exit codes (2: bad
+    input or options, 1: the solve did not converge, 3: unexpected internal error)."""
+    try:
+        body()
+    except typer.Exit:
+        raise
+    except (
+        MeshError,
+        MaterialError,
+        InputError,
+        JobError,
+        OptionsError,
+        OutputExistsError,
+        FileNotFoundError,
+        ValueError,
+    ) as exc:
+        raise typer.Exit(fail(str(exc), 2)) from None
+    except OSError as exc:
+        raise typer.Exit(fail(f"{exc.strerror or exc}: {exc.filename or ''}".strip(), 2)) from None
+    except KeyboardInterrupt:
+        raise typer.Exit(fail("interrupted", 130)) from None
+    except Exception as exc:  # one line, never a traceback
+        raise typer.Exit(fail(f"internal error: {type(exc).__name__}: {exc}", 3)) from None
+
+
+def progress(quiet: bool) -> Callable[[IterationRecord], None] | None:
+    """A callback that prints each Newton iteration (none when ``quiet``)."""
+    if quiet:
+        return None
+
+    def show(record: IterationRecord) -> None:
+        extra = f"  α={record.step_length:.3g} {record.tangent}" if record.iteration else ""
+        console.print(
+            f"  {record.strategy:<18} step {record.step:>2}  τ={record.tau:6.4f}  "
+            f"it {record.iteration:>2}  residual {record.relative_residual:9.3e}  "
+            f"energy {record.energy: .6e}{extra}"
+        )
+
+    return show
+
+
+def field_table(fields: dict[str, np.ndarray]) -> Table:
+    table = Table("field", "min", "mean", "max", title="per-cell results (mean: area-weighted)")
+    statistics = field_statistics(fields)
+    for name in KEY_FIELDS:
+        s = statistics[name]
+        table.add_row(name, f"{s['min']:.6g}", f"{s['mean']:.6g}", f"{s['max']:.6g}")
+    return table
+
+
+def _compensation_table(report) -> Table:
+    table = Table(
+        "",
+        "warp",
+        "fill",
+        title="compensation and prestress (force per length; means area-weighted)",
+    )
+    for row in report.rows():
+        table.add_row(*row)
+    return table
+
+
+def _show_panel(panel: PanelOutcome, detail: bool) -> None:
+    result = panel.result
+    status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
+    console.print(
+        f"{panel.name}: {status} in {result.iterations} iterations "
+        f"({' → '.join(result.strategy)}), {result.elapsed:.2f} s; energy {result.energy:.6e}; "
+        f"area 3D {result.surface_area:.6g}, pattern {result.pattern_area:.6g}"
+    )
+    if result.converged and detail:
+        console.print(field_table(result.fields))
+        if result.prestress is not None and panel.compensation is not None:
+            console.print(_compensation_table(panel.compensation))
+        if result.warp_deviation is not None:
+            console.print(
+                f"mean deviation of the warp from the direction: {result.warp_deviation:.2e}°"
+            )
+
+
+def _show_structure(outcome: JobOutcome) -> None:
+    structure = outcome.structure
+    table = Table(
+        "seam",
+        "segments",
+        "length A",
+        "length B",
+        "mismatch before",
+        "mismatch after",
+        title="seams (pattern lengths)",
+    )
+    for s in structure.seam_reports:
+        table.add_row(
+            f"{s.first} | {s.second}",
+            str(s.segments),
+            f"{s.length_first_after:.6f}",
+            f"{s.length_second_after:.6f}",
+            f"{s.mismatch_before:.2e}",
+            f"{s.mismatch_after:.2e}",
+        )
+    console.print(table)
+    console.print(
+        f"{len(outcome.panels)} panels, {len(structure.seams)} seams, "
+        f"{structure.iterations} coupled iterations; energy {structure.energy:.6e}, price of "
+        f"matching {structure.energy_price:.3e}; {structure.elapsed:.2f} s"
+    )
+
+
+def show(outcome: JobOutcome) -> None:
+    """Print what a job did: per pattern its status (and figures), the structure's seams, the
+    warnings and the files."""
+    single = outcome.structure is None
+    for panel in outcome.panels:
+        _show_panel(panel, detail=single)
+    if not single:
+        _show_structure(outcome)
+    warnings = outcome.panels[0].warnings if single else outcome.warnings
+    if not single:
+        warnings = warnings + [
+            f"{p.name}: {w}" for p in outcome.panels for w in p.warnings if w not in warnings
+        ]
+    for warning in warnings:
+        console.print(f"[yellow]warning:[/] {warning}")
+    for path in outcome.files:
+        console.print(f"  wrote {path}")
+
+
+def execute(job: Job, *, force: bool, quiet: bool, save_job: Path | None = None) -> None:
+    """Run a job from the command line: progress, summary, ``--save-job``, exit status."""
+    if save_job is not None:
+        if save_job.suffix.lower() != ".toml":
+            raise InputError(f"--save-job: a job file ends in .toml; got {save_job}")
+        check_writable([save_job], force)
+
+    def starting(name, mesh, material) -> None:
+        if not quiet:
+            console.print(f"{name}: {mesh}; {material!r}, thickness {job.material.thickness:g}")
+
+    outcome = run_job(job, force=force, callback=progress(quiet), on_solve_start=starting)
+    if save_job is not None:
+        with atomic_path(save_job) as temporary:
+            temporary.write_text(job.to_toml(save_job), encoding="utf-8")
+        outcome.files.append(save_job)
+    if not quiet:
+        show(outcome)
+    if not outcome.converged:
+        what = "solve" if outcome.structure is None else "structure"
+        raise typer.Exit(fail(f"the {what} did not converge: {outcome.reason}", 1))

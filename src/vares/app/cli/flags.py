@@ -1,0 +1,235 @@
+"""Command-line flags derived from the options classes: one flag per option, with the option's
+default, bounds and help, and the values read back into the same options classes.
+
+A command declares ``**values`` and gets its flags with :func:`with_flags`; the values it
+receives become a :class:`vares.app.job.Job` with :func:`job_from_flags`.
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Iterable
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from ...options import Options, OptionsError, Spec
+from ...solver.options import SolveOptions
+from ...structures.options import StructureOptions
+from ..job import Job
+from ..sections import InputOptions, MaterialOptions, OutputOptions, PrestressOptions
+
+__all__ = [
+    "InputError",
+    "build",
+    "flag_name",
+    "flags",
+    "job_from_flags",
+    "numbers",
+    "option_parameter",
+    "with_flags",
+]
+
+#: Help panel of each job-file section.
+PANELS = {
+    "input": "Input",
+    "material": "Material",
+    "fibres": "Fibres",
+    "prestress": "Prestress",
+    "solver": "Solver",
+    "output": "Output",
+    "structure": "Structure",
+}
+#: Kinds given on the command line as one comma-separated string.
+_TEXT_KINDS = {"vector", "plane", "floats", "strings", "paths"}
+
+
+class InputError(Exception):
+    """Bad input or options (exit status 2)."""
+
+
+def option_parameter(
+    name: str, default: Any, kind: Any, *names: str, help: str, panel: str, **extra: Any
+) -> inspect.Parameter:
+    """A keyword parameter that typer reads as the option ``names``."""
+    annotation = Annotated[kind, typer.Option(*names, help=help, rich_help_panel=panel, **extra)]
+    return inspect.Parameter(
+        name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation
+    )
+
+
+def flag_name(name: str, spec: Spec) -> str:
+    """The (first) command-line name of an option."""
+    if spec.flags:
+        return spec.flags[0].split("/")[0]
+    return "--" + name.replace("_", "-")
+
+
+def _enum(name: str, choices: tuple[str, ...]) -> type[StrEnum]:
+    return StrEnum(name, {c: c for c in choices})
+
+
+def flags(
+    cls: type[Options], *, exclude: Iterable[str] = (), defaults: dict[str, Any] | None = None
+) -> list[inspect.Parameter]:
+    """One parameter per option of ``cls`` that has a flag (``Spec.flags != ()``).
+
+    ``defaults`` replaces an option's shown default (e.g. another output folder)."""
+    out = []
+    for name, spec in cls.specs().items():
+        if spec.flags == () or name in exclude:
+            continue
+        default = (defaults or {}).get(name, cls.defaults()[name])
+        names = spec.flags or (flag_name(name, spec),)
+        help_text = spec.help
+        extra: dict[str, Any] = {}
+        if spec.kind in _TEXT_KINDS:
+            kind: Any = str | None
+            if default not in (None, ()):
+                help_text += f" [default: {_text(default)}]"
+            default = None
+            if spec.choices:
+                help_text += f" (fields: {', '.join(spec.choices)})"
+        elif spec.choices is not None:
+            enum = _enum(name.title().replace("_", ""), spec.choices)
+            kind = enum | None if spec.optional else enum
+            default = None if default is None else enum(default)
+            extra["case_sensitive"] = False
+        else:
+            kind = {"bool": bool, "int": int, "float": float, "str": str, "path": str}[spec.kind]
+            kind = kind | None if spec.optional else kind
+            if spec.bounds():
+                help_text += f" ({spec.bounds()})"
+        out.append(
+            option_parameter(
+                name, default, kind, *names, help=help_text, panel=PANELS[spec.section], **extra
+            )
+        )
+    return out
+
+
+def _text(value: Any) -> str:
+    return ",".join(str(v) for v in value) if isinstance(value, tuple) else str(value)
+
+
+def with_flags(*parameter_lists: list[inspect.Parameter]):
+    """Give a ``**values`` command the parameters of ``parameter_lists`` (in order)."""
+
+    def decorate(func):
+        signature = inspect.signature(func)
+        own = [p for p in signature.parameters.values() if p.kind != p.VAR_KEYWORD]
+        extra = [p for group in parameter_lists for p in group]
+        func.__signature__ = signature.replace(parameters=own + extra)
+        return func
+
+    return decorate
+
+
+def numbers(flag: str, text: str) -> tuple[float, ...]:
+    """Numbers from ``"a,b,c"``."""
+    try:
+        return tuple(float(v) for v in text.split(","))
+    except ValueError as exc:
+        raise InputError(f"{flag}: cannot read numbers from {text!r}") from exc
+
+
+def _parse(name: str, spec: Spec, text: str) -> Any:
+    flag = flag_name(name, spec)
+    if spec.kind == "vector" or (spec.kind == "plane" and "," in text):
+        values = numbers(flag, text)
+        if len(values) != 3:
+            raise InputError(f"{flag}: expected three numbers 'x,y,z'; got {text!r}")
+        return values
+    if spec.kind == "floats":
+        return numbers(flag, text)
+    if spec.kind in ("strings", "paths"):
+        return tuple(v.strip() for v in text.split(",") if v.strip())
+    return text
+
+
+def build(cls: type[Options], values: dict[str, Any], **fixed: Any) -> Options:
+    """The options object the flag ``values`` describe (plus ``fixed`` settings); a refused
+    value is an :class:`InputError` naming its flag."""
+    specs = cls.specs()
+    settings: dict[str, Any] = {}
+    for name, spec in specs.items():
+        if name not in values or values[name] is None:
+            continue
+        value = values[name]
+        if spec.kind in _TEXT_KINDS:
+            value = _parse(name, spec, value)
+        elif isinstance(value, StrEnum):
+            value = str(value)
+        elif spec.kind == "path":
+            value = str(Path(value).resolve())
+        settings[name] = value
+    settings.update(fixed)
+    try:
+        return cls(**settings)
+    except OptionsError as exc:
+        if exc.key is None or exc.key not in specs:
+            raise InputError(exc.problem) from None
+        raise InputError(f"{flag_name(exc.key, specs[exc.key])} {exc.problem}") from None
+
+
+#: The composite prestress flags (they set several options of :class:`PrestressOptions`).
+PRESTRESS_FLAGS = [
+    option_parameter(
+        "prestress",
+        None,
+        str | None,
+        "--prestress",
+        help="Prestress along the yarns, force/length: 'WARP,FILL[,SHEAR]' or one value for both.",
+        panel=PANELS["prestress"],
+    ),
+    option_parameter(
+        "prestress_field",
+        None,
+        str | None,
+        "--prestress-field",
+        help="Per-cell prestress from the input's cell data: 'NAME' (columns warp, fill[, shear]) "
+        "or 'WARP_NAME,FILL_NAME'.",
+        panel=PANELS["prestress"],
+    ),
+]
+
+
+def _prestress(values: dict[str, Any]) -> dict[str, Any]:
+    given, field = values.get("prestress"), values.get("prestress_field")
+    if given is not None and field is not None:
+        raise InputError("give --prestress or --prestress-field, not both")
+    if given is not None:
+        parts = numbers("--prestress", given)
+        if len(parts) not in (1, 2, 3):
+            raise InputError(f"--prestress: expected 'WARP,FILL' or one value; got {given!r}")
+        out = {"warp": parts[0], "fill": parts[1 if len(parts) > 1 else 0]}
+        return out | ({"shear": parts[2]} if len(parts) == 3 else {})
+    if field is not None:
+        return {"field": tuple(field.split(","))}
+    return {}
+
+
+#: The flags of a patterning job (pattern, example, panels).
+JOB_FLAGS = (
+    flags(MaterialOptions)
+    + flags(SolveOptions)
+    + PRESTRESS_FLAGS
+    + flags(PrestressOptions)
+    + flags(OutputOptions)
+)
+
+
+def job_from_flags(values: dict[str, Any], *, structure: bool = False, **source: Any) -> Job:
+    """The job the command line describes; ``source`` are the input's settings (mesh, meshes or
+    example, and the like) and paths on the command line are relative to the current folder."""
+    return Job(
+        input=build(InputOptions, values, **source),
+        material=build(MaterialOptions, values),
+        solve=build(SolveOptions, values),
+        prestress=build(PrestressOptions, values, **_prestress(values)),
+        output=build(OutputOptions, values),
+        structure=build(StructureOptions, values) if structure else None,
+        base=Path.cwd(),
+    )

@@ -1,0 +1,61 @@
+"""What running a job produced: per panel, its pattern, report figures, warnings and files."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..analysis.compensation import CompensationReport
+from ..geometry.mesh import SurfaceMesh
+from ..materials import Hyperelastic
+from ..solver.result import PatternResult
+from ..structures.matching import StructureResult
+from .job import Job
+
+__all__ = ["JobOutcome", "PanelOutcome"]
+
+
+@dataclass
+class PanelOutcome:
+    """One pattern of a job: the panel's name, mesh and result, its compensation report (for a
+    converged solve), its warnings and the files written for it (in ``directory``)."""
+
+    name: str
+    mesh: SurfaceMesh
+    result: PatternResult
+    compensation: CompensationReport | None
+    directory: Path
+    warnings: list[str] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+
+
+@dataclass
+class JobOutcome:
+    """What a job produced: one :class:`PanelOutcome` per pattern (one for a single surface),
+    the structure's result for a structure, and every file written."""
+
+    job: Job
+    material: Hyperelastic
+    panels: list[PanelOutcome]
+    structure: StructureResult | None = None
+    files: list[Path] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        if self.structure is not None:
+            return self.structure.converged
+        return self.panels[0].result.converged
+
+    @property
+    def reason(self) -> str | None:
+        if self.structure is not None:
+            return self.structure.reason
+        return self.panels[0].result.reason
+
+    @property
+    def result(self) -> PatternResult:
+        """The pattern of a single-surface job."""
+        if self.structure is not None:
+            raise AttributeError("a structure has one result per panel: use .panels")
+        return self.panels[0].result

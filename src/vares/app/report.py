@@ -1,0 +1,335 @@
+"""Self-contained HTML reports of a patterning job, for a person to read.
+
+One file per pattern with everything inline (pictures as embedded PNG): the input, the material
+and its parameters, the solver's path and convergence history, the pattern drawn with its yarn
+directions, the result fields on the pattern and on the 3D surface, the key figures and the
+warnings. A structure gets one more, for the whole: its panels, its seams before and after
+matching, and links to the panels' reports.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime
+import html
+import io
+from pathlib import Path
+
+import numpy as np
+
+from .._version import __version__
+from ..analysis.statistics import field_statistics
+from ..io.files import atomic_path
+from ..materials import Hyperelastic
+from ..mechanics.fields import KEY_FIELDS
+from .job import Job
+from .outcome import JobOutcome, PanelOutcome
+
+__all__ = ["html_report", "structure_report", "write_reports"]
+
+_STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
+h1 { margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; }
+table { border-collapse: collapse; margin: 0.5em 0 1em; }
+td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }
+th { background: #f2f4f7; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+.status-ok { color: #17702a; font-weight: bold; } .status-bad { color: #b00020; font-weight: bold; }
+.warning { background: #fff4d6; border-left: 4px solid #e0a800; padding: 0.4em 0.8em;
+  margin: 0.3em 0; }
+figure { display: inline-block; margin: 0.5em; vertical-align: top; }
+figure img { max-width: 520px; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; color: #555; }
+"""
+
+_FIGURE_FIELDS = ("det_F", "warp_stress", "fill_stress", "shear_angle", "stress_min")
+
+
+def _png(fig) -> str:
+    import matplotlib.pyplot as plt
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    plt.close(fig)
+    return base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def _figure(fig, caption: str, ident: str) -> str:
+    return (
+        f'<figure id="{ident}"><img alt="{html.escape(caption)}" '
+        f'src="data:image/png;base64,{_png(fig)}"><figcaption>{html.escape(caption)}'
+        "</figcaption></figure>"
+    )
+
+
+def _table(rows, header=None, ident: str | None = None) -> str:
+    attr = f' id="{ident}"' if ident else ""
+    out = [f"<table{attr}>"]
+    if header:
+        out.append("<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>")
+    for row in rows:
+        cells = []
+        for k, cell in enumerate(row):
+            text = html.escape(str(cell))
+            cells.append(f"<th>{text}</th>" if k == 0 else f'<td class="num">{text}</td>')
+        out.append("<tr>" + "".join(cells) + "</tr>")
+    out.append("</table>")
+    return "".join(out)
+
+
+def _g(value: float, digits: int = 5) -> str:
+    return f"{value:.{digits}g}"
+
+
+def _page(title: str, heading: str, status: str, warnings: list[str]) -> list[str]:
+    """The head of a report: title, version, date, status and the warnings."""
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>vares report: {html.escape(title)}</title><style>{_STYLE}</style>",
+        "</head><body>",
+        f"<h1>{html.escape(heading)}</h1>",
+        f"<p>vares {__version__}, {datetime.datetime.now():%Y-%m-%d %H:%M}. Status: {status}</p>",
+        "<h2>Warnings</h2>",
+    ]
+    if warnings:
+        return parts + [f'<div class="warning">{html.escape(w)}</div>' for w in warnings]
+    return [*parts, "<p id='no-warnings'>None.</p>"]
+
+
+def _status(converged: bool, reason: str | None) -> str:
+    if converged:
+        return '<span class="status-ok">converged</span>'
+    return f'<span class="status-bad">not converged: {html.escape(str(reason))}</span>'
+
+
+def _input_section(outcome: PanelOutcome, job: Job) -> list[str]:
+    mesh, units = outcome.mesh, job.input.units
+    cells = ", ".join(f"{len(c)} {t}" for t, c in mesh.cells.items())
+    source = ", ".join(job.input.paths) or f"example {job.input.example}"
+    rows = [
+        ("source", source),
+        ("nodes", mesh.num_points),
+        ("cells", cells),
+        ("surface area", f"{_g(mesh.area)} {units}²"),
+        ("extent (x, y, z)", " × ".join(_g(v, 4) for v in np.ptp(mesh.points, axis=0))),
+    ]
+    return ["<h2>Input</h2>", _table(rows, ident="input")]
+
+
+def _material_section(result, job: Job, material: Hyperelastic) -> list[str]:
+    rows = [("law", type(material).__name__)]
+    rows += [(k, v) for k, v in material.parameters.items()]
+    rows.append(("thickness", result.thickness))
+    if job.material.fabric is not None:
+        rows.append(("fabric preset", job.material.fabric))
+    rows.append(("fibre orientation", result.orientation))
+    warp, fill = (np.round(v, 4).tolist() for v in (result.fibres.warp, result.fibres.fill))
+    rows.append(("warp / fill in the pattern", f"{warp} / {fill}"))
+    if result.warp_direction is not None:
+        rows.append(("warp direction (3D)", np.round(result.warp_direction, 4).tolist()))
+        rows.append(("mean warp deviation", f"{result.warp_deviation:.2e}°"))
+    if result.prestress is not None:
+        p = result.prestress
+        per_cell = " (per cell)" if len(p) > 1 else ""
+        rows.append(
+            (
+                "prestress warp / fill",
+                f"{_g(float(p[:, 0].mean()))} / {_g(float(p[:, 1].mean()))}{per_cell}",
+            )
+        )
+    return ["<h2>Material and fibres</h2>", _table(rows, ident="material")]
+
+
+def _key_figures(outcome: PanelOutcome, units: str) -> list[str]:
+    result, mesh = outcome.result, outcome.mesh
+    key = [
+        ("surface area", f"{_g(mesh.area)} {units}²"),
+        ("pattern area", f"{_g(result.pattern_area)} {units}²"),
+        ("pattern / surface area", f"{100 * (result.pattern_area / mesh.area - 1):+.3f} %"),
+        ("energy", _g(result.energy)),
+        ("Newton iterations", result.iterations),
+        ("strategy", " → ".join(result.strategy)),
+        ("initial guess", result.initial_guess),
+        ("linear solver", result.linear_solver),
+        ("time", f"{result.elapsed:.2f} s"),
+    ]
+    if result.converged:
+        stats = field_statistics(result.fields)
+        for name in KEY_FIELDS:
+            s = stats[name]
+            key.append(
+                (f"{name} (min / mean / max)", f"{_g(s['min'])} / {_g(s['mean'])} / {_g(s['max'])}")
+            )
+        key.append(("wrinkling area", f"{100 * stats['wrinkling']['mean']:.1f} %"))
+    parts = ["<h2>Key figures</h2>", _table(key, ident="key-figures")]
+    if outcome.compensation is not None and result.prestress is not None:
+        parts += [
+            "<h2>Compensation and prestress</h2>",
+            _table(outcome.compensation.rows(), header=("", "warp", "fill"), ident="compensation"),
+        ]
+    return parts
+
+
+def _convergence_section(result) -> list[str]:
+    from ..io.plot import plot_convergence
+
+    steps = [
+        (
+            s.strategy,
+            s.step,
+            f"{s.tau:.4g}",
+            s.iterations,
+            "yes" if s.converged else "no",
+            s.reason or "",
+        )
+        for s in result.steps
+    ]
+    return [
+        "<h2>Convergence</h2>",
+        _figure(
+            plot_convergence(result.history),
+            "relative residual per Newton iteration",
+            "figure-convergence",
+        ),
+        _table(
+            steps,
+            header=("strategy", "step", "τ", "iterations", "converged", "reason"),
+            ident="steps",
+        ),
+    ]
+
+
+def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]:
+    from ..io.plot import plot_pattern, plot_surface
+
+    result, mesh, fields = outcome.result, outcome.mesh, outcome.result.fields
+    x = result.material_coordinates
+    scale = material.stiffness_scale * result.thickness
+    parts = [
+        "<h2>Pattern</h2>",
+        _figure(
+            plot_pattern(mesh, x, fibres=result.fibres, title="pattern"),
+            "the pattern with warp and fill",
+            "figure-pattern",
+        ),
+    ]
+    for name in _FIGURE_FIELDS:
+        figure = plot_pattern(
+            mesh, x, fields[name], field=name, fibres=result.fibres, title=name, stress_scale=scale
+        )
+        parts.append(_figure(figure, f"{name} on the pattern", f"figure-{name}"))
+    surface_det_f = plot_surface(mesh, fields["det_F"], field="det_F", title="det F")
+    surface_warp = plot_surface(
+        mesh, fields["warp_stress"], field="warp_stress", title="warp stress", stress_scale=scale
+    )
+    return [
+        *parts,
+        "<h2>On the surface</h2>",
+        _figure(surface_det_f, "det F on the 3D surface", "figure-surface-det_F"),
+        _figure(surface_warp, "warp stress on the 3D surface", "figure-surface-warp_stress"),
+    ]
+
+
+def html_report(outcome: PanelOutcome, job: Job, material: Hyperelastic) -> str:
+    """The report of one pattern of a job as one HTML document."""
+    result = outcome.result
+    parts = _page(
+        outcome.name,
+        f"Cutting pattern: {outcome.name}",
+        _status(result.converged, result.reason),
+        outcome.warnings,
+    )
+    parts += _input_section(outcome, job)
+    parts += _material_section(result, job, material)
+    parts += _key_figures(outcome, job.input.units)
+    parts += _convergence_section(result)
+    if result.converged:
+        parts += _pattern_figures(outcome, material)
+    files = [(f.name, str(f)) for f in outcome.files]
+    parts += [
+        "<h2>Files</h2>",
+        _table(files, header=("file", "path"), ident="files"),
+        "</body></html>",
+    ]
+    return "\n".join(parts)
+
+
+def structure_report(outcome: JobOutcome) -> str:
+    """The report of a structure: status, panels (with links to their reports), seams."""
+    structure = outcome.structure
+    units = outcome.job.input.units
+    panels = [
+        (
+            p.name,
+            p.mesh.num_cells,
+            f"{_g(p.mesh.area)} {units}²",
+            f"{_g(p.result.pattern_area)} {units}²",
+            "yes" if p.result.converged else "no",
+            p.result.iterations,
+        )
+        for p in outcome.panels
+    ]
+    links = "".join(
+        f'<li><a href="{html.escape(p.directory.name)}/report.html">{html.escape(p.name)}</a></li>'
+        for p in outcome.panels
+    )
+    seams = [
+        (
+            f"{s.first} | {s.second}",
+            s.segments,
+            _g(s.length_first_after, 8),
+            _g(s.length_second_after, 8),
+            f"{s.mismatch_before:.2e}",
+            f"{s.mismatch_after:.2e}",
+        )
+        for s in structure.seam_reports
+    ]
+    key = [
+        ("panels", len(outcome.panels)),
+        ("seams", len(structure.seams)),
+        ("seam matching", "yes" if structure.matched else "no"),
+        ("coupled iterations", structure.iterations),
+        ("energy, panels alone", _g(structure.energy_independent)),
+        ("energy, seams matched", _g(structure.energy)),
+        ("price of matching", f"{structure.energy_price:.3e}"),
+        ("time", f"{structure.elapsed:.2f} s"),
+    ]
+    status = _status(structure.converged, structure.reason)
+    parts = [
+        *_page("structure", "Structure", status, outcome.warnings),
+        "<h2>Key figures</h2>",
+        _table(key, ident="key-figures"),
+        "<h2>Panels</h2>",
+        _table(
+            panels,
+            header=("panel", "cells", "surface area", "pattern area", "converged", "iterations"),
+            ident="panels",
+        ),
+        f"<ul id='panel-reports'>{links}</ul>",
+        "<h2>Seams (pattern lengths)</h2>",
+        _table(
+            seams,
+            header=("seam", "segments", "length A", "length B", "mismatch before", "after"),
+            ident="seams",
+        ),
+        "</body></html>",
+    ]
+    return "\n".join(parts)
+
+
+def write_reports(outcome: JobOutcome) -> None:
+    """Write each pattern's ``report.html`` (and the structure's), atomically; the paths go to
+    the outcome's file lists."""
+    for panel in outcome.panels:
+        path = panel.directory / "report.html"
+        _write_text(path, html_report(panel, outcome.job, outcome.material))
+        panel.files.append(path)
+        outcome.files.append(path)
+    if outcome.structure is not None:
+        path = outcome.job.directory / "report.html"
+        _write_text(path, structure_report(outcome))
+        outcome.files.append(path)
+
+
+def _write_text(path: Path, text: str) -> None:
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8")

@@ -1,0 +1,207 @@
+"""Initial guesses: orthogonal projection onto a plane, or a conformal flattening (LSCM).
+
+The plane also defines the pseudo-time path of DESIGN.md §1: ``x(τ) = P(x) + τ (x − P(x))``
+with ``P`` the orthogonal projection onto it, so that at ``τ = 0`` the projected coordinates
+are the exact stress-free pattern. Where the projection folds or flattens cells badly (a surface
+steeper than about 78° to the plane, or turning by more than 180°), the least-squares conformal
+map is the better start.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .elements import ELEMENTS
+from .mesh import SurfaceMesh
+
+__all__ = [
+    "PlaneSpec",
+    "ProjectionPlane",
+    "lscm",
+    "projection_distortion",
+    "projection_plane",
+    "signed_area",
+]
+
+_NAMED_PLANES = {
+    "xy": (0, 1),
+    "x-y": (0, 1),
+    "yz": (1, 2),
+    "y-z": (1, 2),
+    "zx": (2, 0),
+    "z-x": (2, 0),
+    "xz": (0, 2),
+    "x-z": (0, 2),
+}
+
+PlaneSpec = str | Sequence[float] | np.ndarray | None
+
+
+@dataclass(frozen=True)
+class ProjectionPlane:
+    """A plane through ``origin`` with orthonormal in-plane axes ``axes[0]``, ``axes[1]`` and
+    ``normal = axes[0] × axes[1]``. Pattern coordinates are ``(x − origin) · axes``.
+    """
+
+    origin: np.ndarray
+    axes: np.ndarray  # (2, 3)
+
+    @property
+    def normal(self) -> np.ndarray:
+        return np.cross(self.axes[0], self.axes[1])
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """In-plane coordinates ``(n, 2)`` of 3D points ``(n, 3)``."""
+        return (points - self.origin) @ self.axes.T
+
+    def height(self, points: np.ndarray) -> np.ndarray:
+        """Signed distance of each point from the plane."""
+        return (points - self.origin) @ self.normal
+
+    def lift(self, points: np.ndarray, tau: float) -> np.ndarray:
+        """The pseudo-time surface ``P(x) + τ (x − P(x))``."""
+        return points - (1.0 - tau) * np.outer(self.height(points), self.normal)
+
+
+def signed_area(mesh: SurfaceMesh, coordinates: np.ndarray) -> float:
+    """Total signed area of the mesh laid out at 2D ``coordinates`` (negative if mirrored)."""
+    return float(sum(ELEMENTS[t].areas(coordinates, c).sum() for t, c in mesh.cells.items()))
+
+
+def projection_plane(mesh: SurfaceMesh, plane: PlaneSpec = None) -> ProjectionPlane:
+    """The plane of the initial guess.
+
+    ``plane`` is ``None`` or ``"best-fit"`` (least-squares plane of the nodes), a coordinate
+    plane name (``"xy"``, ``"yz"``, ``"zx"``, also written ``"x-y"`` …) or a normal vector
+    ``(3,)``. The in-plane axes are chosen so that the projected cells keep the mesh's
+    orientation (positive area); with a coordinate plane they are the coordinate axes when
+    possible, e.g. ``"xy"`` gives pattern coordinates ``(x, y)`` for a mesh facing +z.
+    """
+    points = mesh.points
+    origin = points.mean(axis=0)
+    if plane is None or (isinstance(plane, str) and plane.lower() in ("best-fit", "bestfit")):
+        _, _, vt = np.linalg.svd(points - origin, full_matrices=False)
+        normal = vt[2]
+        first = None
+    elif isinstance(plane, str):
+        key = plane.lower().replace(" ", "")
+        if key not in _NAMED_PLANES:
+            raise ValueError(
+                f"unknown plane {plane!r}; use 'best-fit', 'xy', 'yz', 'zx' or a normal vector"
+            )
+        i, j = _NAMED_PLANES[key]
+        eye = np.eye(3)
+        first, normal = eye[i], np.cross(eye[i], eye[j])
+    else:
+        normal = np.asarray(plane, dtype=float)
+        if normal.shape != (3,) or not np.all(np.isfinite(normal)) or not normal.any():
+            raise ValueError(f"a plane normal must be a non-zero finite 3-vector; got {plane!r}")
+        first = None
+    normal = normal / np.linalg.norm(normal)
+    if first is None:
+        # First axis: the global axis that lies most in the plane, projected onto it.
+        eye = np.eye(3)
+        candidate = eye[np.argmin(np.abs(eye @ normal))]
+        first = candidate - (candidate @ normal) * normal
+    first = first / np.linalg.norm(first)
+    axes = np.array([first, np.cross(normal, first)])
+    if signed_area(mesh, mesh.points @ axes.T) < 0:
+        axes[1] = -axes[1]  # view from the other side so the pattern keeps the cell orientation
+    return ProjectionPlane(origin, axes)
+
+
+def _triangles(mesh: SurfaceMesh) -> np.ndarray:
+    """All cells as triangles (quads split along their 0–2 diagonal), ``(k, 3)``."""
+    parts = []
+    for cell_type, cells in mesh.cells.items():
+        if cell_type == "triangle":
+            parts.append(cells)
+        else:
+            parts.append(cells[:, [0, 1, 2]])
+            parts.append(cells[:, [0, 2, 3]])
+    return np.vstack(parts)
+
+
+def lscm(mesh: SurfaceMesh) -> np.ndarray:
+    """Least-squares conformal map (Lévy et al. 2002) of the surface, scaled to its 3D area.
+
+    Minimises ``Σ_t A_t |∇v − R₉₀ ∇u|²`` (the Cauchy–Riemann residual of each triangle in its own
+    plane) with two far-apart nodes pinned, by one sparse direct solve of the normal equations.
+    The map keeps the cells' orientation; it is conformal, not isometric, so it is rescaled to
+    the 3D area. Returns pattern coordinates ``(n, 2)``.
+    """
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    points = mesh.points
+    tris = _triangles(mesh)
+    p0, p1, p2 = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
+    e1 = p1 - p0
+    normal = np.cross(e1, p2 - p0)
+    double_area = np.linalg.norm(normal, axis=1)
+    ex = e1 / np.linalg.norm(e1, axis=1)[:, None]
+    ey = np.cross(normal / double_area[:, None], ex)
+    # local coordinates of the corners: (0, 0), (x1, 0), (x2, y2)
+    x1 = np.einsum("ij,ij->i", e1, ex)
+    x2 = np.einsum("ij,ij->i", p2 - p0, ex)
+    y2 = np.einsum("ij,ij->i", p2 - p0, ey)
+    # gradients of the three linear shape functions (constant per triangle)
+    gx = np.column_stack([-y2, y2, np.zeros_like(y2)]) / (x1 * y2)[:, None]
+    gy = np.column_stack([x2 - x1, -x2, x1]) / (x1 * y2)[:, None]
+    weight = np.sqrt(0.5 * double_area)[:, None]
+    n, k = mesh.num_points, len(tris)
+    rows = np.repeat(np.arange(k), 3).reshape(k, 3)
+    # unknowns: u at 2i, v at 2i+1; residuals r1 = u_x − v_y, r2 = u_y + v_x
+    data = np.concatenate(
+        [
+            (weight * gx).ravel(),
+            (-weight * gy).ravel(),
+            (weight * gy).ravel(),
+            (weight * gx).ravel(),
+        ]
+    )
+    row_index = np.concatenate(
+        [2 * rows.ravel(), 2 * rows.ravel(), 2 * rows.ravel() + 1, 2 * rows.ravel() + 1]
+    )
+    col_index = np.concatenate(
+        [2 * tris.ravel(), 2 * tris.ravel() + 1, 2 * tris.ravel(), 2 * tris.ravel() + 1]
+    )
+    matrix = sp.csr_matrix((data, (row_index, col_index)), shape=(2 * k, 2 * n))
+
+    centred = points - points.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    first, second = int(np.argmin(centred @ axis)), int(np.argmax(centred @ axis))
+    pinned = np.array([2 * first, 2 * first + 1, 2 * second, 2 * second + 1])
+    pinned_values = np.array([0.0, 0.0, np.linalg.norm(points[second] - points[first]), 0.0])
+    free = np.setdiff1d(np.arange(2 * n), pinned)
+    a_free, a_pinned = matrix[:, free], matrix[:, pinned]
+    normal_matrix = (a_free.T @ a_free).tocsc()
+    rhs = -(a_free.T @ (a_pinned @ pinned_values))
+    solution = np.empty(2 * n)
+    solution[pinned] = pinned_values
+    solution[free] = spsolve(normal_matrix, rhs)
+    coordinates = solution.reshape(-1, 2)
+    coordinates -= coordinates.mean(axis=0)
+    flat_area = signed_area(mesh, coordinates)
+    if flat_area <= 0:
+        raise ValueError("the conformal map is degenerate for this surface")
+    return coordinates * np.sqrt(mesh.area / flat_area)
+
+
+def projection_distortion(mesh: SurfaceMesh, plane: ProjectionPlane) -> float:
+    """Smallest ratio of projected to 3D area element over all cells (≤ 0 where it folds).
+
+    Evaluated where ``det J`` is checked (a triangle's single value, a quad's corners): 1 for a
+    surface parallel to the plane, ``cos θ`` where the surface is inclined by ``θ``.
+    """
+    coordinates = plane.project(mesh.points)
+    ratios = []
+    for cell_type, cells in mesh.cells.items():
+        element = ELEMENTS[cell_type]
+        j = element.jacobians(coordinates, cells, at="check")
+        det = j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
+        ratios.append((det / element.corner_areas(mesh.points, cells)).ravel())
+    return float(np.concatenate(ratios).min())

@@ -1,0 +1,321 @@
+"""Surface meshes: the fixed 3D shape whose cutting pattern is sought.
+
+`SurfaceMesh` follows meshio's data model: ``points`` of shape ``(n, 3)`` and ``cells``, a
+mapping from meshio cell type names (``"triangle"``, ``"quad"``) to integer index arrays.
+A mesh is validated once, on construction, so that everything downstream may assume a
+single connected, open, manifold, consistently oriented surface without degenerate cells.
+Reading and writing mesh files is :mod:`vares.io`'s.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .elements import ELEMENTS
+
+__all__ = ["MeshError", "SurfaceMesh"]
+
+
+class MeshError(ValueError):
+    """The input is not a surface that can be patterned; the message names cells or nodes."""
+
+
+def _listing(indices: np.ndarray, limit: int = 8) -> str:
+    """Render the first few offending indices for an error message."""
+    indices = np.asarray(indices).ravel()
+    shown = ", ".join(str(int(i)) for i in indices[:limit])
+    more = f", … ({indices.size} in all)" if indices.size > limit else ""
+    return shown + more
+
+
+class SurfaceMesh:
+    """A validated, immutable surface mesh.
+
+    Parameters
+    ----------
+    points
+        Node coordinates, shape ``(n, 3)`` (``(n, 2)`` is taken as a flat surface, z = 0).
+    cells
+        Mapping of meshio cell type (``"triangle"`` ``(m, 3)``, ``"quad"`` ``(m, 4)``, meshio's
+        node order) to node index arrays. Mixed meshes are allowed.
+    drop_unused_nodes
+        Nodes referenced by no cell are an error by default; with ``True`` they are removed
+        (with a warning) and :attr:`node_map` maps the kept nodes to the given indices.
+
+    Error messages name cells by type and index within their block, and nodes by their index
+    in the given ``points``.
+    """
+
+    def __init__(
+        self,
+        points: np.ndarray,
+        cells: Mapping[str, np.ndarray],
+        *,
+        drop_unused_nodes: bool = False,
+    ) -> None:
+        points = np.array(points, dtype=float)
+        if points.ndim != 2 or points.shape[1] not in (2, 3):
+            raise MeshError(f"points must have shape (n, 3); got {points.shape}")
+        if points.shape[1] == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        if len(points) == 0:
+            raise MeshError("the mesh has no points")
+        bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+        if bad.size:
+            raise MeshError(f"non-finite coordinates (NaN or inf) at nodes {_listing(bad)}")
+
+        clean: dict[str, np.ndarray] = {}
+        for cell_type, block in cells.items():
+            if cell_type not in ELEMENTS:
+                raise MeshError(
+                    f"cell type {cell_type!r} is not supported; a surface mesh needs "
+                    f"{' or '.join(repr(t) for t in ELEMENTS)} cells"
+                )
+            arr = np.asarray(block)
+            nen = ELEMENTS[cell_type].num_nodes
+            if arr.size == 0:
+                continue
+            if arr.ndim != 2 or arr.shape[1] != nen:
+                raise MeshError(f"{cell_type!r} cells must have shape (m, {nen}); got {arr.shape}")
+            if not np.issubdtype(arr.dtype, np.integer):
+                if not np.all(np.equal(np.mod(arr, 1), 0)):
+                    raise MeshError(f"{cell_type!r} cell indices must be integers")
+            arr = arr.astype(np.int64)
+            if cell_type in clean:
+                arr = np.vstack([clean[cell_type], arr])
+            clean[cell_type] = arr
+        if not clean:
+            raise MeshError("the mesh has no triangle or quad cells")
+
+        num_points = len(points)
+        for cell_type, arr in clean.items():
+            out = np.flatnonzero(((arr < 0) | (arr >= num_points)).any(axis=1))
+            if out.size:
+                raise MeshError(
+                    f"{cell_type} cells {_listing(out)} refer to nodes outside 0..{num_points - 1}"
+                )
+
+        used = np.zeros(num_points, dtype=bool)
+        for arr in clean.values():
+            used[arr.ravel()] = True
+        node_map = np.arange(num_points)
+        if not used.all():
+            unused = np.flatnonzero(~used)
+            if not drop_unused_nodes:
+                raise MeshError(
+                    f"nodes {_listing(unused)} belong to no cell "
+                    "(pass drop_unused_nodes=True to remove them)"
+                )
+            warnings.warn(
+                f"dropped {unused.size} node(s) that belong to no cell: {_listing(unused)}",
+                stacklevel=2,
+            )
+            node_map = np.flatnonzero(used)
+            renumber = np.full(num_points, -1, dtype=np.int64)
+            renumber[node_map] = np.arange(node_map.size)
+            points = points[node_map]
+            clean = {t: renumber[a] for t, a in clean.items()}
+
+        self._points = points
+        self._cells = clean
+        self._node_map = node_map
+        for arr in (self._points, self._node_map, *self._cells.values()):
+            arr.setflags(write=False)
+        self._validate()
+
+    # ------------------------------------------------------------------ properties
+    @property
+    def points(self) -> np.ndarray:
+        """Node coordinates ``(n, 3)`` (read-only)."""
+        return self._points
+
+    @property
+    def cells(self) -> dict[str, np.ndarray]:
+        """Cell blocks by meshio type name (read-only arrays)."""
+        return dict(self._cells)
+
+    @property
+    def node_map(self) -> np.ndarray:
+        """For each node, its index in the points given to the constructor."""
+        return self._node_map
+
+    @property
+    def num_points(self) -> int:
+        return len(self._points)
+
+    @property
+    def num_cells(self) -> int:
+        return sum(len(a) for a in self._cells.values())
+
+    def cell_areas(self) -> np.ndarray:
+        """3D area of every cell in global cell order, shape ``(num_cells,)``."""
+        return np.concatenate([ELEMENTS[t].areas(self._points, a) for t, a in self._cells.items()])
+
+    @property
+    def area(self) -> float:
+        """Total 3D surface area."""
+        return float(self.cell_areas().sum())
+
+    def boundary_edges(self) -> np.ndarray:
+        """Boundary edges ``(k, 2)``, each oriented as in its cell."""
+        edges, _, counts = self._edge_table()
+        return edges[counts == 1]
+
+    def transformed(self, points: np.ndarray) -> SurfaceMesh:
+        """The same topology with new node coordinates ``(n, 3)``."""
+        return SurfaceMesh(points, self._cells)
+
+    def __repr__(self) -> str:
+        blocks = ", ".join(f"{len(a)} {t}" for t, a in self._cells.items())
+        return f"SurfaceMesh({self.num_points} points; {blocks})"
+
+    # ------------------------------------------------------------------ validation
+    def _global_cells(self) -> list[tuple[str, np.ndarray, int]]:
+        out, offset = [], 0
+        for t, a in self._cells.items():
+            out.append((t, a, offset))
+            offset += len(a)
+        return out
+
+    def _describe_cells(self, global_ids: np.ndarray) -> str:
+        """Name cells by type and index within the type."""
+        parts = []
+        for t, a, offset in self._global_cells():
+            mine = global_ids[(global_ids >= offset) & (global_ids < offset + len(a))] - offset
+            if mine.size:
+                parts.append(f"{t} cells {_listing(np.unique(mine))}")
+        return "; ".join(parts)
+
+    def _directed_edges(self) -> tuple[np.ndarray, np.ndarray]:
+        """All directed cell edges ``(k, 2)`` and the global cell each belongs to."""
+        edges, owner = [], []
+        for _t, a, offset in self._global_cells():
+            nen = a.shape[1]
+            for i in range(nen):
+                edges.append(np.column_stack([a[:, i], a[:, (i + 1) % nen]]))
+                owner.append(offset + np.arange(len(a)))
+        return np.vstack(edges), np.concatenate(owner)
+
+    def _edge_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Directed edges, the undirected edge id of each, and the number of cells per id."""
+        directed, _ = self._directed_edges()
+        key = np.sort(directed, axis=1)
+        _, edge_id, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        edge_id = edge_id.ravel()
+        return directed, edge_id, counts[edge_id]
+
+    def _validate(self) -> None:
+        points = self._points
+        scale = float(np.ptp(points, axis=0).max()) or 1.0
+
+        for t, a, _ in self._global_cells():
+            repeated = np.flatnonzero((np.diff(np.sort(a, axis=1), axis=1) == 0).any(axis=1))
+            if repeated.size:
+                raise MeshError(f"degenerate {t} cells {_listing(repeated)} repeat a node")
+            # Smallest corner parallelogram area of each cell, relative to the model size.
+            corner = ELEMENTS[t].corner_areas(points, a).min(axis=1)
+            flat = np.flatnonzero(corner <= 1e-12 * scale**2)
+            if flat.size:
+                raise MeshError(
+                    f"degenerate {t} cells {_listing(flat)} have (nearly) zero area "
+                    "or collinear corners"
+                )
+
+        directed, owner = self._directed_edges()
+        key = np.sort(directed, axis=1)
+        _, edge_id, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        edge_id = edge_id.ravel()
+
+        over = np.flatnonzero(counts > 2)
+        if over.size:
+            e = key[np.flatnonzero(np.isin(edge_id, over))]
+            cells_at = owner[np.isin(edge_id, over)]
+            raise MeshError(
+                f"non-manifold edges: edge {tuple(int(v) for v in self._node_map[e[0]])} is "
+                "shared by more "
+                f"than two cells ({self._describe_cells(np.unique(cells_at))})"
+            )
+
+        # Two cells sharing an edge must traverse it in opposite directions.
+        order = np.argsort(edge_id, kind="stable")
+        sorted_ids = edge_id[order]
+        pair_start = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
+        first, second = order[pair_start], order[pair_start + 1]
+        same_direction = directed[first, 0] == directed[second, 0]
+        if same_direction.any():
+            bad = np.unique(
+                np.concatenate([owner[first[same_direction]], owner[second[same_direction]]])
+            )
+            raise MeshError(
+                "inconsistent orientation: neighbouring cells traverse a shared edge in the same "
+                f"direction ({self._describe_cells(bad)}); orient all cells consistently"
+            )
+
+        if not (counts == 1).any():
+            raise MeshError(
+                "the surface is closed (it has no boundary edge): a closed surface has no "
+                "cutting pattern; cut it open along a seam line first"
+            )
+
+        num_cells = self.num_cells
+        # Cells are connected through shared edges; nodes join cells only through edges.
+        adjacency = sp.coo_matrix(
+            (np.ones(first.size), (owner[first], owner[second])), shape=(num_cells, num_cells)
+        )
+        num_pieces, label = connected_components(adjacency, directed=False)
+        if num_pieces > 1:
+            sizes = np.bincount(label)
+            raise MeshError(
+                f"the mesh has {num_pieces} disconnected pieces (cells per piece: "
+                f"{_listing(sizes)}); pattern each piece separately (one file per panel: "
+                "'vares panels a.obj b.obj …')"
+            )
+
+        self._check_manifold_vertices(directed, owner, edge_id)
+
+    def _check_manifold_vertices(
+        self, directed: np.ndarray, owner: np.ndarray, edge_id: np.ndarray
+    ) -> None:
+        """Around each node the cells must form a single fan (no 'bow-tie' nodes)."""
+        # Corners are (cell, node) pairs; two corners at the same node are linked when their
+        # cells share an edge that contains that node.
+        corner_cell = owner
+        corner_node = directed[:, 0]  # each directed edge starts at exactly one corner
+        num_corners = corner_cell.size
+        corner_key = corner_cell * self.num_points + corner_node
+        order = np.argsort(corner_key)
+        sorted_key = corner_key[order]
+
+        def corner_of(cell: np.ndarray, node: np.ndarray) -> np.ndarray:
+            return order[np.searchsorted(sorted_key, cell * self.num_points + node)]
+
+        srt = np.argsort(edge_id, kind="stable")
+        ids = edge_id[srt]
+        pair = np.flatnonzero(ids[1:] == ids[:-1])
+        a, b = srt[pair], srt[pair + 1]
+        rows, cols = [], []
+        for k in (0, 1):
+            node = directed[a, k]
+            rows.append(corner_of(owner[a], node))
+            cols.append(corner_of(owner[b], node))
+        graph = sp.coo_matrix(
+            (np.ones(2 * a.size), (np.concatenate(rows), np.concatenate(cols))),
+            shape=(num_corners, num_corners),
+        )
+        _, fan = connected_components(graph, directed=False)
+        fans_per_node = np.bincount(
+            np.unique(np.column_stack([corner_node, fan]), axis=0)[:, 0],
+            minlength=self.num_points,
+        )
+        bow_tie = np.flatnonzero(fans_per_node > 1)
+        if bow_tie.size:
+            raise MeshError(
+                f"non-manifold nodes {_listing(self._node_map[bow_tie])}: the cells around "
+                "each of them form "
+                "separate fans that touch only at the node"
+            )

@@ -1,0 +1,21 @@
+"""Files: mesh and pattern files, Rhino models, DXF for the cutter, drawings, JSON summaries.
+
+Every file is written atomically (:func:`vares.io.files.atomic_path`); none is overwritten unless
+the caller allows it. Drawings (matplotlib) and DXF (ezdxf) are imported where used.
+"""
+
+from .files import OutputExistsError, atomic_path, check_writable, write_json
+from .meshes import read_mesh, read_mesh_data, read_pattern, write_surface
+from .summary import summary
+
+__all__ = [
+    "OutputExistsError",
+    "atomic_path",
+    "check_writable",
+    "read_mesh",
+    "read_mesh_data",
+    "read_pattern",
+    "summary",
+    "write_json",
+    "write_surface",
+]

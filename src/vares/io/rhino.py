@@ -1,0 +1,142 @@
+"""Rhino ``.3dm`` files: meshes, and the render meshes of surfaces and polysurfaces.
+
+Every object that carries a mesh becomes a named surface: its object name, or else its layer
+path, or else ``object-K``. A surface or polysurface (Brep, extrusion) has a mesh only when the
+file was saved with render meshes (Rhino's default for shaded views); one without is skipped
+and named in the error if no mesh is left.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry.mesh import MeshError, SurfaceMesh
+
+__all__ = ["NamedMesh", "read_3dm", "write_3dm"]
+
+
+@dataclass(frozen=True)
+class NamedMesh:
+    """A mesh read from a file, with the name and layer it had there."""
+
+    name: str
+    layer: str
+    mesh: SurfaceMesh
+
+
+def _rhino_mesh_arrays(mesh) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    vertices = mesh.Vertices
+    points = np.array([[vertices[i].X, vertices[i].Y, vertices[i].Z] for i in range(len(vertices))])
+    triangles, quads = [], []
+    faces = mesh.Faces
+    for k in range(faces.Count):
+        face = faces[k]
+        if face[2] == face[3]:
+            triangles.append(face[:3])
+        else:
+            quads.append(face)
+    cells = {}
+    if triangles:
+        cells["triangle"] = np.array(triangles, dtype=np.int64)
+    if quads:
+        cells["quad"] = np.array(quads, dtype=np.int64)
+    return points, cells
+
+
+def _weld(parts: list[tuple[np.ndarray, dict[str, np.ndarray]]]):
+    """Join meshes, merging coincident vertices (render meshes of adjacent Brep faces)."""
+    points = np.vstack([p for p, _ in parts])
+    scale = float(np.ptp(points, axis=0).max()) or 1.0
+    keys = np.round(points / (1e-9 * scale)).astype(np.int64)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    cells: dict[str, list[np.ndarray]] = {}
+    offset = 0
+    for part_points, part_cells in parts:
+        for cell_type, block in part_cells.items():
+            cells.setdefault(cell_type, []).append(inverse[block + offset])
+        offset += len(part_points)
+    return points[first], {t: np.vstack(b) for t, b in cells.items()}
+
+
+def read_3dm(path: str | Path) -> list[NamedMesh]:
+    """All meshes of a Rhino file, named (see the module docs).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    MeshError
+        Not a readable 3dm file, no usable mesh in it, or an invalid mesh (naming the object).
+    """
+    import rhino3dm
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path}")
+    model = rhino3dm.File3dm.Read(str(path))
+    if model is None:
+        raise MeshError(f"cannot read {path}: not a Rhino 3dm file, or a damaged one")
+    layers = {i: model.Layers[i].FullPath for i in range(len(model.Layers))}
+    out, skipped = [], []
+    for index, obj in enumerate(model.Objects):
+        geometry, attributes = obj.Geometry, obj.Attributes
+        layer = layers.get(attributes.LayerIndex, "")
+        name = attributes.Name or layer or f"object-{index}"
+        parts = []
+        if isinstance(geometry, rhino3dm.Mesh):
+            parts.append(_rhino_mesh_arrays(geometry))
+        elif isinstance(geometry, rhino3dm.Brep):
+            for k in range(len(geometry.Faces)):
+                face_mesh = geometry.Faces[k].GetMesh(rhino3dm.MeshType.Any)
+                if face_mesh is not None:
+                    parts.append(_rhino_mesh_arrays(face_mesh))
+        elif isinstance(geometry, rhino3dm.Extrusion):
+            extrusion_mesh = geometry.GetMesh(rhino3dm.MeshType.Any)
+            if extrusion_mesh is not None:
+                parts.append(_rhino_mesh_arrays(extrusion_mesh))
+        else:
+            continue
+        parts = [p for p in parts if p[1]]
+        if not parts:
+            skipped.append(name)
+            continue
+        points, cells = parts[0] if len(parts) == 1 else _weld(parts)
+        try:
+            mesh = SurfaceMesh(points, cells, drop_unused_nodes=True)
+        except MeshError as exc:
+            raise MeshError(f"{path}: object {name!r}: {exc}") from exc
+        out.append(NamedMesh(name, layer, mesh))
+    if not out:
+        detail = f" (no render mesh in {', '.join(skipped)}: save with meshes)" if skipped else ""
+        raise MeshError(f"{path} contains no usable mesh{detail}")
+    return out
+
+
+def write_3dm(path: str | Path, meshes: list[NamedMesh]) -> None:
+    """Write meshes to a Rhino file, each as a named object on a layer of its own name."""
+    import rhino3dm
+
+    model = rhino3dm.File3dm()
+    layer_index: dict[str, int] = {}
+    for named in meshes:
+        layer_name = named.layer or named.name
+        if layer_name not in layer_index:
+            layer = rhino3dm.Layer()
+            layer.Name = layer_name
+            layer_index[layer_name] = model.Layers.Add(layer)
+        mesh = rhino3dm.Mesh()
+        for x, y, z in named.mesh.points:
+            mesh.Vertices.Add(float(x), float(y), float(z))
+        for cells in named.mesh.cells.values():
+            for cell in cells:
+                mesh.Faces.AddFace(*(int(v) for v in cell))
+        attributes = rhino3dm.ObjectAttributes()
+        attributes.Name = named.name
+        attributes.LayerIndex = layer_index[layer_name]
+        model.Objects.AddMesh(mesh, attributes)
+    if not model.Write(str(path), 7):
+        raise OSError(f"could not write {path}")

@@ -1,0 +1,25 @@
+"""The energy of erecting a pattern: prestress, element kernels, the problem, assembly, rigid
+modes, and the per-cell response (stresses, stretches) of any pattern."""
+
+from .assembly import Assembler
+from .fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
+from .kernels import BlockResult, block_energy, projected_hessian
+from .prestress import PrestressWarning, prestress_components, prestress_tensor
+from .problem import Evaluation, Problem
+from .rigid import rigid_modes
+
+__all__ = [
+    "FIELD_DESCRIPTIONS",
+    "KEY_FIELDS",
+    "Assembler",
+    "BlockResult",
+    "Evaluation",
+    "PrestressWarning",
+    "Problem",
+    "block_energy",
+    "cell_fields",
+    "prestress_components",
+    "prestress_tensor",
+    "projected_hessian",
+    "rigid_modes",
+]

@@ -1,0 +1,292 @@
+"""Newton–Raphson on one energy, with the globalisations every strategy is built from.
+
+The iteration works on any *objective*: an object with the methods of
+:class:`vares.mechanics.Problem` that it uses,
+
+- ``evaluate(x, order=2)``: energy, per-block gradients and Hessians (and ``∂²W/∂J²``);
+- ``projected_hessians(evaluation)``: the Hessians made positive semi-definite point by point;
+- ``energy(x)``: the energy, ``inf`` where ``x`` is not admissible;
+- ``inverted_cells(x)``: the cells that make ``x`` inadmissible;
+- ``admissible_step(x, delta)``: the largest ``α`` keeping ``x + α delta`` admissible,
+
+so the forward (erection) problem can be solved by the same code as the pattern. The unknowns
+are ``x.ravel()[assembler.free]``, optionally subject to one linear constraint ``cᵀΔx = 0``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..mechanics.assembly import Assembler
+from .linear import LinearSolver, SingularMatrixError
+from .result import IterationRecord, StepRecord
+
+__all__ = [
+    "EXACT_TANGENT_BELOW",
+    "METHODS",
+    "ROUND_OFF_REGIME",
+    "Failure",
+    "NewtonContext",
+    "at_round_off",
+    "describe_cells",
+    "newton",
+]
+
+#: Relative residual below which globalised Newton returns from projected to exact tangents.
+EXACT_TANGENT_BELOW = 1e-2
+#: Below this relative residual, full Newton steps that twice in a row fail to halve the residual
+#: mean it has reached the round-off floor of the mesh (ill-shaped cells make the floor higher
+#: than a tight tolerance): the iteration stops there (see :func:`at_round_off`).
+ROUND_OFF_REGIME = 1e-6
+#: ``"full"``: plain Newton; ``"line-search"``: globalised; ``"damped"``: Levenberg–Marquardt.
+METHODS = ("full", "line-search", "damped")
+
+
+class Failure(Exception):
+    """A Newton iteration (or a strategy) did not converge; ``coordinates`` is where it stopped
+    (never inverted)."""
+
+    def __init__(self, reason: str, coordinates: np.ndarray) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.coordinates = coordinates
+
+
+def describe_cells(ids: np.ndarray, limit: int = 5) -> str:
+    """``"3 cell(s) (4, 7, 9)"`` for messages."""
+    shown = ", ".join(str(int(i)) for i in ids[:limit])
+    return f"{ids.size} cell(s) ({shown}{', …' if ids.size > limit else ''})"
+
+
+def at_round_off(residuals: list[float], step_lengths: list[float]) -> bool:
+    """True when the last two full Newton steps (step length 1) each failed to halve the
+    relative residual, below :data:`ROUND_OFF_REGIME`: near the solution Newton's method
+    converges quadratically, so such a stall is the floor that round-off sets, not slowness."""
+    if len(residuals) < 3 or residuals[-1] > ROUND_OFF_REGIME:
+        return False
+    stalled = all(residuals[k] > 0.5 * residuals[k - 1] for k in (-1, -2))
+    return stalled and step_lengths[-1] == 1.0 and step_lengths[-2] == 1.0
+
+
+@dataclass
+class NewtonContext:
+    """What every Newton iteration of one solve shares: the dof map, the linear solver, the
+    convergence test, and the records of the iterations and steps."""
+
+    assembler: Assembler
+    linear_solver: LinearSolver
+    residual_tolerance: float
+    energy_noise: float
+    force_scale: float
+    max_iterations: int
+    history: list[IterationRecord]
+    steps: list[StepRecord]
+    callback: Callable[[IterationRecord], None] | None
+    constraint: np.ndarray | None = None
+
+    def residual(self, gradient: np.ndarray) -> np.ndarray:
+        """The residual over the free dofs, less its component along the linear constraint."""
+        r = gradient.ravel()[self.assembler.free]
+        if self.constraint is not None:
+            r = r - self.constraint * (self.constraint @ r)
+        return r
+
+    def step(self, matrix: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+        """Solve the Newton system, bordered by the linear constraint when there is one."""
+        if self.constraint is None:
+            self.linear_solver.factorize(matrix)
+            return self.linear_solver.solve(rhs)
+        column = sp.csr_matrix(self.constraint[:, None])
+        bordered = sp.bmat([[matrix, column], [column.T, None]], format="csr")
+        self.linear_solver.factorize(bordered)
+        return self.linear_solver.solve(np.append(rhs, 0.0))[:-1]
+
+    def record(self, record: IterationRecord) -> None:
+        self.history.append(record)
+        if self.callback is not None:
+            self.callback(record)
+
+    def attempt(
+        self, name: str, step: int, tau: float, run: Callable[[], np.ndarray]
+    ) -> np.ndarray:
+        """Run one Newton solve and record it as a step (failed ones too, then re-raised)."""
+        before = len(self.history)
+        try:
+            x = run()
+        except Failure as failure:
+            iterations = len(self.history) - before - 1
+            self.steps.append(StepRecord(name, step, tau, iterations, False, failure.reason))
+            raise
+        self.steps.append(
+            StepRecord(name, step, tau, len(self.history) - before - 1, True, None, x)
+        )
+        return x
+
+
+@dataclass
+class _Damping:
+    """State of the damped iteration: the coefficient ``c`` and how fast it grows on rejection."""
+
+    factor: float
+    c: float | None = None
+    growth: float = 2.0
+
+    def cap(self, matrix: sp.csr_matrix, residual: float, initial_residual: float) -> None:
+        scale = self.factor * float(np.mean(np.abs(matrix.diagonal())))
+        cap = scale * min(1.0, residual / initial_residual) if initial_residual > 0 else scale
+        self.c = cap if self.c is None else min(self.c, cap)
+
+    def reject(self) -> None:
+        self.c, self.growth = self.c * self.growth, 2.0 * self.growth
+
+
+def newton(
+    problem,
+    coordinates: np.ndarray,
+    ctx: NewtonContext,
+    *,
+    strategy: str,
+    step: int,
+    tau: float,
+    method: str = "line-search",
+    damping: float = 1.0,
+) -> np.ndarray:
+    """Newton–Raphson on one surface from ``coordinates``; returns the converged pattern.
+
+    ``method`` is
+
+    - ``"full"``: plain Newton, full steps; a step that inverts a cell ends it.
+    - ``"line-search"``: globalised Newton. The step is bounded so that every ``det J`` stays
+      positive and backtracked until the energy decreases enough (Armijo). Far from the
+      solution (relative residual at or above :data:`EXACT_TANGENT_BELOW`) the tangent is the
+      quadrature-point-wise positive semi-definite projection of the exact one (projected
+      Newton: always a descent direction); below it the exact tangent, so the final convergence
+      is quadratic, with the projection as fallback whenever the exact step is no descent.
+    - ``"damped"``: each iteration solves ``(K + c I) ΔX = −r`` and accepts the step only if it
+      lowers the energy without inverting a cell; ``c`` (starting at ``damping`` × the mean
+      tangent diagonal) follows the gain ratio of actual to predicted decrease (Nielsen's rule)
+      and is capped in proportion to the residual, so it vanishes as the iteration converges.
+
+    Raises :class:`Failure` when it does not converge.
+    """
+    x = coordinates.copy()
+    initial_residual = None
+    state = _Damping(damping)
+    step_length, tangent = 0.0, ""
+    residuals: list[float] = []
+    step_lengths: list[float] = []
+    for iteration in range(ctx.max_iterations + 1):
+        evaluation = problem.evaluate(x, order=2)
+        residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
+        residual = float(np.linalg.norm(residual_vector))
+        initial_residual = residual if initial_residual is None else initial_residual
+        residuals.append(residual / ctx.force_scale)
+        step_lengths.append(step_length)
+        converged = residual <= ctx.residual_tolerance or at_round_off(residuals, step_lengths)
+        # far from the solution (by the residual) the projected tangent, near it the exact one
+        projected = (
+            method == "line-search"
+            and not converged
+            and residual >= EXACT_TANGENT_BELOW * ctx.force_scale
+        )
+        hessians = problem.projected_hessians(evaluation) if projected else evaluation.hessians
+        matrix = None if converged else ctx.assembler.matrix(hessians)
+        if method == "damped" and matrix is not None:
+            state.cap(matrix, residual, initial_residual)
+        ctx.record(
+            IterationRecord(
+                strategy,
+                step,
+                tau,
+                iteration,
+                residual,
+                residual / ctx.force_scale,
+                evaluation.energy,
+                state.c or 0.0,
+                step_length,
+                tangent,
+            )
+        )
+        if not (np.isfinite(residual) and np.isfinite(evaluation.energy)):
+            raise Failure("non-finite energy or residual", x)
+        if converged:
+            return x
+        if iteration == ctx.max_iterations:
+            raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
+        if method == "full":
+            x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector)
+        elif method == "damped":
+            x, step_length, tangent = _damped_step(
+                problem, x, ctx, matrix, residual_vector, evaluation.energy, state
+            )
+        else:
+            x, step_length, tangent = _line_search_step(
+                problem, x, ctx, evaluation, matrix, residual_vector, projected
+            )
+    raise AssertionError("unreachable")
+
+
+def _full_step(problem, x, ctx, matrix, residual_vector):
+    """A plain Newton step; one that inverts a cell ends the iteration."""
+    try:
+        delta = ctx.step(matrix, -residual_vector)
+    except SingularMatrixError as exc:
+        raise Failure(f"singular tangent ({exc})", x) from exc
+    trial = x.copy()
+    trial.ravel()[ctx.assembler.free] += delta
+    inverted = problem.inverted_cells(trial)
+    if inverted.size:
+        raise Failure(f"inverted elements: {describe_cells(inverted)}", x)
+    return trial, 1.0, "exact"
+
+
+def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Damping):
+    """A Levenberg–Marquardt step: ``c`` grows until the step lowers the energy."""
+    identity = sp.identity(ctx.assembler.num_free, format="csr")
+    for _attempt in range(60):
+        try:
+            delta = ctx.step(matrix + state.c * identity, -residual_vector)
+        except SingularMatrixError:
+            state.reject()
+            continue
+        trial = x.copy()
+        trial.ravel()[ctx.assembler.free] += delta
+        predicted = -(residual_vector @ delta + 0.5 * delta @ (matrix @ delta))
+        actual = energy - problem.energy(trial)
+        if predicted > 0 and actual >= -ctx.energy_noise:
+            gain = actual / predicted
+            state.c *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
+            state.growth = 2.0
+            return trial, 1.0, "damped"
+        state.reject()
+    raise Failure("damping could not find an admissible step", x)
+
+
+def _line_search_step(problem, x, ctx, evaluation, matrix, residual_vector, projected):
+    """A globalised step: exact tangent first (projected where that gives no descent), bounded
+    to keep every cell admissible, backtracked until the energy falls enough (Armijo)."""
+    for attempt in ("projected",) if projected else ("exact", "projected"):
+        if attempt == "projected" and not projected:
+            projected = True
+            matrix = ctx.assembler.matrix(problem.projected_hessians(evaluation))
+        try:
+            delta = ctx.step(matrix, -residual_vector)
+        except SingularMatrixError:
+            continue
+        slope = float(residual_vector @ delta)
+        if not slope < 0:
+            continue
+        full = np.zeros_like(x)
+        full.ravel()[ctx.assembler.free] = delta
+        alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
+        for _backtrack in range(40):
+            trial = x + alpha * full
+            energy = problem.energy(trial)
+            if energy <= evaluation.energy + 1e-4 * alpha * slope + ctx.energy_noise:
+                return trial, alpha, "projected" if projected else "exact"
+            alpha *= 0.5
+    raise Failure("the line search found no decrease of the energy", x)

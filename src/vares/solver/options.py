@@ -1,0 +1,124 @@
+"""The options of a solve: fibre orientation and solver settings, each declared once.
+
+:class:`SolveOptions` is the single place where a default or a bound of these settings is
+written. :func:`vares.solve` takes its fields as keyword arguments, job files hold them in their
+``[fibres]`` and ``[solver]`` tables, and the command line has one flag per field.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..options import Options, OptionsError, option
+from .linear import SOLVER_NAMES
+
+__all__ = ["INITIAL_GUESSES", "ORIENTATIONS", "STRATEGIES", "SolveOptions"]
+
+STRATEGIES = ("auto", "newton", "pseudo-time", "damping")
+ORIENTATIONS = ("held", "free")
+INITIAL_GUESSES = ("auto", "projection", "lscm")
+
+
+@dataclass(frozen=True)
+class SolveOptions(Options):
+    """How a pattern is oriented and found (see :func:`vares.solve`)."""
+
+    title = "solver option"
+
+    warp_angle: float = option(
+        0.0,
+        "float",
+        "Warp angle in the pattern frame, degrees from the pattern x-axis.",
+        section="fibres",
+    )
+    fill_angle: float | None = option(
+        None,
+        "float",
+        "Fill angle in the pattern frame, degrees (default warp + 90).",
+        section="fibres",
+    )
+    warp_direction: tuple[float, float, float] | None = option(
+        None,
+        "vector",
+        "3D direction 'x,y,z' the warp follows on the erected surface (overrides the warp "
+        "angle; the pattern is returned with the warp along +x).",
+        section="fibres",
+    )
+    orientation: str = option(
+        "held",
+        "str",
+        "Anisotropic laws or prestress: keep the initial guess's rotation (held) or let the "
+        "energy choose it (free).",
+        section="fibres",
+        choices=ORIENTATIONS,
+    )
+    strategy: str = option(
+        "auto",
+        "str",
+        "Solution strategy.",
+        section="solver",
+        choices=STRATEGIES,
+        flags=("--strategy", "-s"),
+    )
+    steps: int = option(
+        3, "int", "Equal pseudo-time steps (strategy pseudo-time).", section="solver", minimum=1
+    )
+    initial_guess: str = option(
+        "auto",
+        "str",
+        "Start: projection onto the plane, the conformal map (lscm), or auto (the projection "
+        "unless no plane is named and it folds or flattens a cell below 0.2 of its area).",
+        section="solver",
+        choices=INITIAL_GUESSES,
+    )
+    plane: str | tuple[float, float, float] | None = option(
+        None,
+        "plane",
+        "Initial-guess plane: best-fit, xy, yz, zx, or a normal 'nx,ny,nz' (default: best-fit; "
+        "an example's own).",
+        section="solver",
+    )
+    tolerance: float = option(
+        1e-10,
+        "float",
+        "Relative residual tolerance: |residual| ≤ tolerance × stiffness × thickness × "
+        "√area (and seam matching's).",
+        section="solver",
+        positive=True,
+    )
+    max_iterations: int = option(
+        50,
+        "int",
+        "Newton iterations per step (and of seam matching).",
+        section="solver",
+        minimum=1,
+    )
+    damping: float = option(
+        1.0,
+        "float",
+        "Initial damping of the damping strategy, relative to the mean tangent diagonal.",
+        section="solver",
+        positive=True,
+    )
+    linear_solver: str | None = option(
+        None,
+        "str",
+        "Linear solver (default: the fastest installed).",
+        section="solver",
+        choices=SOLVER_NAMES,
+    )
+
+    def check(self) -> None:
+        if self.warp_direction is not None and self.orientation == "free":
+            raise OptionsError(
+                None, "a warp direction fixes the orientation; it cannot also be free"
+            )
+        if self.strategy == "pseudo-time" and self.initial_guess == "lscm":
+            raise OptionsError(
+                None, "pseudo-time stepping starts from the projection, not from the conformal map"
+            )
+
+    @property
+    def named_plane(self) -> bool:
+        """True when a plane other than the best-fit one is asked for."""
+        return self.plane not in (None, "best-fit")
