@@ -26,7 +26,13 @@ EXAMPLE_FLAG = [
 ]
 
 
-@with_flags(flags(InputOptions), EXAMPLE_FLAG, JOB_FLAGS, flags(StructureOptions), RUN_FLAGS)
+@with_flags(
+    flags(InputOptions, exclude=("name",)),
+    EXAMPLE_FLAG,
+    JOB_FLAGS,
+    flags(StructureOptions),
+    RUN_FLAGS,
+)
 def panels(
     inputs: Annotated[
         list[Path] | None,
