@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from vares.app.batch import is_complete, run_batch
 from vares.app.cli import app
-from vares.app.job import load_job
+from vares.app.job import JobError, load_job
 
 runner = CliRunner()
 
@@ -43,10 +43,24 @@ def test_local_batch_reports_failures_and_skips_complete_jobs(tmp_path):
     assert all(is_complete(load_job(p)) for p in paths)
     again = run_batch(paths, workers=2)
     assert [s.status for s in again] == ["skipped"] * 3
-    # a changed job is not complete any more
+    # a changed job is not complete any more; its earlier results are replaced only with force
+    before = (tmp_path / "out0" / "summary.json").read_text()
     paths[0].write_text(paths[0].read_text().replace("nu = 0.1", "nu = 0.2"))
     assert not is_complete(load_job(paths[0]))
-    assert [s.status for s in run_batch(paths, workers=1)] == ["done", "skipped", "skipped"]
+    statuses = run_batch(paths, workers=1)
+    assert [s.status for s in statuses] == ["failed", "skipped", "skipped"]
+    assert "output exists" in statuses[0].message
+    assert (tmp_path / "out0" / "summary.json").read_text() == before
+    assert [s.status for s in run_batch(paths[:1], workers=1, force=True)] == ["done"]
+    assert is_complete(load_job(paths[0]))
+
+
+def test_jobs_sharing_an_output_folder_are_refused_before_any_work(tmp_path):
+    paths = write_jobs(tmp_path, 2)
+    paths[1].write_text(paths[1].read_text().replace('"out1"', '"out0"'))
+    with pytest.raises(JobError, match="write into the same folder"):
+        run_batch(paths, workers=1)
+    assert not (tmp_path / "out0").exists()
 
 
 def test_batch_command(tmp_path):

@@ -92,8 +92,8 @@ def test_existing_outputs_are_not_overwritten_without_force(tmp_path):
     [
         ("", "is empty"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 nan\nf 1 2 3\n", "non-finite coordinates"),
-        ("v 0 0 0\nv 1 0 0\nf 1 2 5\n", "refer to nodes outside"),
-        ("this is not a mesh\n", "contains no triangle or quad cells"),
+        ("v 0 0 0\nv 1 0 0\nf 1 2 5\n", "face 1 refers to vertex 5 but the file has 2 vertices"),
+        ("this is not a mesh\n", "contains no vertices"),
     ],
 )
 def test_bad_input_gives_one_line_and_exit_2(tmp_path, content, message):

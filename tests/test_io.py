@@ -15,7 +15,7 @@ import vares
 from vares.app.cli import app
 from vares.app.job import JobError, load_job
 from vares.geometry.examples import grid_cells
-from vares.io.dxf import CutPiece, boundary_loops, write_dxf
+from vares.io.dxf import CutPiece, write_dxf
 from vares.io.rhino import NamedMesh, read_3dm, write_3dm
 
 runner = CliRunner()
@@ -125,7 +125,7 @@ def test_boundary_loops_with_a_hole():
     points = np.column_stack([x.ravel(), y.ravel(), np.zeros(16)])
     quads = grid_cells(4, 4, "quad")["quad"]
     ring = np.delete(quads, 4, axis=0)  # remove the centre cell
-    loops = boundary_loops(vares.SurfaceMesh(points, {"quad": ring}))
+    loops = vares.SurfaceMesh(points, {"quad": ring}).boundary_loops()
     assert [len(loop) for loop in loops] == [12, 4]
     path_area = [
         0.5

@@ -148,7 +148,7 @@ def test_split_panels_errors():
     assert sum(p.mesh.num_cells for p in panels) == mesh.num_cells
     assert panels[2].mesh.num_cells == 1
     ids[-1] = 7  # a second, far away cell: the panel falls apart
-    with pytest.raises(vares.MeshError, match=r"panel patch: .*2 disconnected pieces"):
+    with pytest.raises(vares.MeshError, match=r"panel patch: .*2 separate pieces"):
         split_panels(mesh, ids, {7: "patch"})
 
 
@@ -323,6 +323,7 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
     single = _cli("pattern", source, "-o", tmp_path / "single", "--plot", "det_F", "-q")
     assert single.exit_code == 0, single.stderr
     expected = {p.name for p in (tmp_path / "single").iterdir()} | {"surface.obj", "report.html"}
+    expected -= {".vares-run.json"}  # the manifest of a run is in its output folder only
     names = ["panel-0", "panel-1"]
     for name in names:
         assert {p.name for p in (out / name).iterdir()} == expected
@@ -331,6 +332,7 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
         "structure.json",
         "structure.dxf",
         "report.html",
+        ".vares-run.json",
     }
     report = (out / "report.html").read_text()
     assert all(f'href="{name}/report.html"' in report for name in names)

@@ -137,12 +137,17 @@ def test_singular_tangent_is_reported(monkeypatch):
     assert not result.converged and result.reason.startswith("singular tangent")
 
 
-def test_folding_projection_is_reported():
+def test_folding_projection_is_reported_or_passed_over():
     mesh = cylinder160(angle=220.0, n_around=22, n_along=2)
-    result = vares.solve(mesh, NEO_HOOKE, plane="xy")
+    result = vares.solve(mesh, NEO_HOOKE, plane="xy", initial_guess="projection")
     assert not result.converged
     assert "projection onto the plane inverts" in result.reason
     assert result.iterations == 0
+    with pytest.warns(
+        UserWarning, match="the projection folds 16 cell.*started from the conformal map"
+    ):
+        result = vares.solve(mesh, NEO_HOOKE, plane="xy")
+    assert result.converged and result.initial_guess == "lscm"
 
 
 def test_user_initial_guess_and_plane_normal():

@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 from multiprocessing import get_context
 from pathlib import Path
 
-from .job import Job, load_job
+from .job import Job, JobError, load_job
 from .runner import run_job
 
 __all__ = ["JobStatus", "is_complete", "run_batch", "run_job_file"]
@@ -42,14 +42,33 @@ def _summary_path(job: Job) -> Path:
     return job.directory / ("summary.json" if job.structure is None else "structure.json")
 
 
+def _previous(job: Job) -> dict:
+    try:
+        return json.loads(_summary_path(job).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+
+
 def is_complete(job: Job) -> bool:
     """True when the job's outputs exist, converged, and were written for this very job."""
-    path = _summary_path(job)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return False
+    data = _previous(job)
     return bool(data.get("converged")) and data.get("job_digest") == job.digest()
+
+
+def _refuse_shared_outputs(paths: list[str]) -> None:
+    """Two jobs writing into one folder would lose one result: refuse before any work."""
+    seen: dict[Path, str] = {}
+    for path in paths:
+        try:
+            directory = load_job(path).directory.resolve()
+        except (OSError, ValueError):
+            continue  # reported when the job runs
+        if directory in seen:
+            raise JobError(
+                f"{seen[directory]} and {path} write into the same folder {directory}: "
+                "give each job its own [output] directory"
+            )
+        seen[directory] = path
 
 
 def _limit_threads(threads: int) -> None:
@@ -72,7 +91,9 @@ def run_job_file(path: str, force: bool = False) -> JobStatus:
         output = str(_summary_path(job).parent)
         if not force and is_complete(job):
             return JobStatus(str(path), "skipped", "complete", 0.0, output)
-        outcome = run_job(job, force=True)
+        # an unfinished run of this very job is replaced; anything else only with force
+        own = _previous(job).get("job_digest") == job.digest()
+        outcome = run_job(job, force=force or own)
         status = "done" if outcome.converged else "not converged"
         iterations = sum(p.result.iterations for p in outcome.panels)
         energy = sum(p.result.energy for p in outcome.panels)
@@ -108,6 +129,7 @@ def run_batch(
     paths = [str(Path(p).resolve()) for p in paths]
     if not paths:
         return []
+    _refuse_shared_outputs(paths)
     statuses: dict[str, JobStatus] = {}
 
     def finished(status: JobStatus) -> None:

@@ -1,4 +1,5 @@
-"""Reading a job's input: one surface, or the panels of a structure."""
+"""Reading a job's input: one surface, or the panels of a structure — repaired, in known units,
+with what was changed or is doubtful said aloud."""
 
 from __future__ import annotations
 
@@ -8,75 +9,142 @@ import numpy as np
 
 from ..geometry.examples import EXAMPLES, STRUCTURE_EXAMPLES
 from ..geometry.mesh import MeshError
-from ..io.meshes import read_mesh, read_mesh_data
-from ..io.rhino import read_3dm
+from ..io.meshes import MeshFile, read_mesh_file, read_pattern
+from ..io.rhino import read_3dm, unit_system
 from ..structures.panels import Panel, split_panels
+from ..units import implausible_size
 from .job import Job, JobError
 
-__all__ = ["Input", "load_input"]
+__all__ = ["DEFAULT_UNITS", "Input", "load_input"]
+
+#: Units of coordinates when neither the file nor the job names any.
+DEFAULT_UNITS = "m"
 
 
 @dataclass
 class Input:
-    """The surfaces of a job (one for a single pattern) and, for a single mesh file, its cell
-    data in global cell order."""
+    """The surfaces of a job (one for a single pattern), the cell data of a single mesh file
+    (global cell order), the length units, what the repair changed (per file), warnings about
+    the input, and the pattern to start from (if the job names one)."""
 
     panels: list[Panel]
+    units: str
     cell_data: dict[str, np.ndarray] = field(default_factory=dict)
+    repairs: dict[str, dict[str, object]] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+    initial_pattern: np.ndarray | None = None
 
 
 def load_input(job: Job) -> Input:
     """Read the job's surface or panels; clear errors for inputs that do not fit the job."""
     source = job.input
     if source.example is not None:
-        return _example(job)
-    if job.structure is None:
+        loaded = _example(job)
+    elif job.structure is None:
         if source.meshes is not None:
             raise JobError("several mesh files are a structure: pattern them with 'vares panels'")
-        path = job.path(source.mesh)
-        mesh, cell_data = read_mesh_data(path)
-        return Input([Panel(source.name or path.stem, mesh)], cell_data)
-    return Input(_structure_panels(job))
+        mesh_file = _read(job, source.mesh)
+        panel = Panel(source.name or mesh_file.path.stem, mesh_file.surface())
+        loaded = Input([panel], _units(job, [mesh_file.units]), mesh_file.cell_data)
+        _note(loaded, [mesh_file])
+    else:
+        loaded = _structure(job)
+    if source.initial_pattern is not None:
+        if job.structure is not None:
+            raise JobError("an initial pattern file is for a single surface, not a structure")
+        path = job.path(source.initial_pattern)
+        loaded.initial_pattern = read_pattern(path, loaded.panels[0].mesh)
+    extent = max(float(np.ptp(p.mesh.points, axis=0).max()) for p in loaded.panels)
+    doubt = implausible_size(extent, loaded.units)
+    if doubt is not None:
+        loaded.warnings.append(doubt)
+    return loaded
+
+
+def _read(job: Job, path: str) -> MeshFile:
+    return read_mesh_file(job.path(path), repair=job.input.repair)
+
+
+def _units(job: Job, declared: list[str | None]) -> str:
+    """The job's units: the file's own, or those the job names (they must agree)."""
+    named = {d for d in declared if d is not None}
+    if len(named) > 1:
+        raise JobError(f"the input files declare different units: {', '.join(sorted(named))}")
+    given = job.input.units
+    if named and given is not None and given not in named:
+        raise JobError(
+            f"the input declares its coordinates in {named.pop()}, the job says {given}: "
+            "drop --units (the file's own are used) or fix the file"
+        )
+    return next(iter(named), given or DEFAULT_UNITS)
+
+
+def _note(loaded: Input, files: list[MeshFile]) -> None:
+    for mesh_file in files:
+        if mesh_file.repair.changed:
+            loaded.repairs[mesh_file.path.name] = mesh_file.repair.to_dict()
+            loaded.warnings.append(
+                f"repaired {mesh_file.path.name}: {'; '.join(mesh_file.repair.actions())}"
+            )
+        precision = mesh_file.precision_warning()
+        if precision is not None:
+            loaded.warnings.append(precision)
 
 
 def _example(job: Job) -> Input:
     name, cell_type = job.input.example, job.input.cell_type
+    units = _units(job, [])
     if job.structure is None:
         if name in STRUCTURE_EXAMPLES:
             raise JobError(f"example {name!r} is a structure: pattern it with 'vares panels'")
         mesh = EXAMPLES[name](cell_type=cell_type)
-        return Input([Panel(job.input.name or name, mesh)])
+        return Input([Panel(job.input.name or name, mesh)], units)
     if name not in STRUCTURE_EXAMPLES:
         raise JobError(
             f"example {name!r} is a single surface; structure examples: "
             f"{', '.join(STRUCTURE_EXAMPLES)}"
         )
     mesh, ids = STRUCTURE_EXAMPLES[name](cell_type=cell_type)
-    return Input(split_panels(mesh, ids, {int(i): f"strip-{int(i) + 1}" for i in np.unique(ids)}))
+    names = {int(i): f"strip-{int(i) + 1}" for i in np.unique(ids)}
+    return Input(split_panels(mesh, ids, names), units)
 
 
-def _structure_panels(job: Job) -> list[Panel]:
-    files = [job.path(p) for p in job.input.paths]
-    if len(files) > 1:
-        panels = [Panel(f.stem, read_mesh(f)) for f in files]
-    elif files[0].suffix.lower() == ".3dm":
-        panels = [Panel(m.name, m.mesh) for m in read_3dm(files[0])]
+def _structure(job: Job) -> Input:
+    paths = [job.path(p) for p in job.input.paths]
+    if len(paths) == 1 and paths[0].suffix.lower() == ".3dm":
+        panels = [Panel(m.name, m.mesh) for m in read_3dm(paths[0])]
+        loaded = Input(panels, _units(job, [unit_system(paths[0])]))
+    elif len(paths) > 1:
+        files = [_read(job, p) for p in paths]
+        panels = [Panel(f.path.stem, f.surface()) for f in files]
+        loaded = Input(panels, _units(job, [f.units for f in files]))
+        _note(loaded, files)
     else:
-        mesh, cell_data = read_mesh_data(files[0])
-        key = job.input.panel_field
-        if key not in cell_data:
-            raise MeshError(
-                f"{files[0]} has no cell data {key!r} with panel ids "
-                f"(it has: {', '.join(cell_data) or 'none'})"
-            )
-        panels = split_panels(mesh, cell_data[key])
-    if len(panels) < 2:
+        mesh_file = _read(job, paths[0])
+        panels = _split(job, mesh_file)
+        loaded = Input(panels, _units(job, [mesh_file.units]))
+        _note(loaded, [mesh_file])
+    if len(loaded.panels) < 2:
         raise JobError("a structure needs at least two panels")
-    names = [p.name for p in panels]
+    names = [p.name for p in loaded.panels]
     clashes = sorted({n for n in names if names.count(n) > 1})
     if clashes:
         raise JobError(
             f"two panels are named {clashes[0]!r}: their outputs would overwrite each other "
             "(rename the files or objects)"
         )
-    return panels
+    return loaded
+
+
+def _split(job: Job, mesh_file: MeshFile) -> list[Panel]:
+    """Panels by the panel field of the cell data or, without one, the mesh's separate pieces."""
+    key = job.input.panel_field
+    if key in mesh_file.cell_data:
+        return split_panels(mesh_file.surface(), mesh_file.cell_data[key])
+    pieces = mesh_file.pieces()
+    if len(pieces) < 2:
+        raise MeshError(
+            f"{mesh_file.path} is one piece and has no cell data {key!r} with panel ids "
+            f"(it has: {', '.join(mesh_file.cell_data) or 'none'})"
+        )
+    return [Panel(f"{mesh_file.path.stem}-{k + 1}", mesh) for k, (mesh, _) in enumerate(pieces)]

@@ -72,7 +72,8 @@ SECTIONS: dict[str, str] = {
 @dataclass(frozen=True)
 class Job:
     """A patterning job: one options object per part; ``structure`` is set for a structure of
-    several panels. ``base`` is the folder relative paths are relative to."""
+    several panels. ``base`` is the folder relative paths are relative to; ``location`` the
+    job file it was read from (if any)."""
 
     input: InputOptions
     material: MaterialOptions = field(default_factory=MaterialOptions)
@@ -81,6 +82,7 @@ class Job:
     output: OutputOptions = field(default_factory=OutputOptions)
     structure: StructureOptions | None = None
     base: Path = field(default_factory=Path.cwd)
+    location: Path | None = None
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], origin: str = "job", base: Path | None = None) -> Job:
@@ -224,4 +226,5 @@ def load_job(path: str | Path) -> Job:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise JobError(f"{path}: not valid TOML: {exc}") from exc
-    return Job.from_dict(data, str(path), path.parent.resolve())
+    job = Job.from_dict(data, str(path), path.parent.resolve())
+    return replace(job, location=path.resolve())

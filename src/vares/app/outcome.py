@@ -25,6 +25,7 @@ class PanelOutcome:
     result: PatternResult
     compensation: CompensationReport | None
     directory: Path
+    units: str = "m"
     warnings: list[str] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
 
@@ -32,12 +33,16 @@ class PanelOutcome:
 @dataclass
 class JobOutcome:
     """What a job produced: one :class:`PanelOutcome` per pattern (one for a single surface),
-    the structure's result for a structure, and every file written."""
+    the structure's result for a structure, the output folder, the length units, what the
+    input's repair changed, and every file written."""
 
     job: Job
     material: Hyperelastic
     panels: list[PanelOutcome]
     structure: StructureResult | None = None
+    directory: Path = Path()
+    units: str = "m"
+    repairs: dict[str, dict[str, object]] = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 

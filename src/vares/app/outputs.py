@@ -20,6 +20,7 @@ summaries.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 
@@ -27,12 +28,13 @@ import numpy as np
 
 from .._version import __version__
 from ..analysis.statistics import field_statistics
-from ..io.dxf import UNITS, CutPiece, write_dxf
+from ..io.dxf import CutPiece, write_dxf
 from ..io.files import atomic_path, write_json
 from ..io.meshes import write_surface
 from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
+from ..units import METRES
 from .inputs import Input
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
@@ -56,13 +58,16 @@ def safe_name(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "panel"
 
 
-def panel_directory(job: Job, name: str) -> Path:
-    """Where a panel's files go: the output directory, or its own folder in a structure's."""
-    return job.directory if job.structure is None else job.directory / safe_name(name)
+def panel_directory(job: Job, name: str, root: Path | None = None) -> Path:
+    """Where a panel's files go: the output folder ``root`` (default: the job's), or a folder
+    of its own in it for a structure's panel."""
+    root = job.directory if root is None else root
+    return root if job.structure is None else root / safe_name(name)
 
 
-def planned_files(job: Job, source: Input) -> list[Path]:
-    """Every file the job may write (checked for clashes before any work is done)."""
+def planned_files(job: Job, source: Input, save_job: Path | None = None) -> list[Path]:
+    """Every file the job may write (checked for clashes before any work is done); a job file
+    saved inside the output folder is one of them."""
     folders = [safe_name(p.name) for p in source.panels]
     clashes = sorted({f for f in folders if folders.count(f) > 1})
     if clashes:
@@ -81,28 +86,44 @@ def planned_files(job: Job, source: Input) -> list[Path]:
     if job.structure is not None:
         names = ["structure.json", "structure.dxf"] + (["report.html"] if job.output.report else [])
         files += [job.directory / n for n in names]
+    if save_job is not None and job.directory.resolve() in save_job.resolve().parents:
+        files.append(save_job)
     return files
 
 
-def write_panel(
-    panel: PanelOutcome, job: Job, material_scale: float, marks: np.ndarray | None = None
-) -> None:
+def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | None = None) -> None:
     """The files of one pattern (all of them when it converged, else the summary and the
     surface); the paths go to ``panel.files``."""
-    result = panel.result
+    job, result = outcome.job, panel.result
     if job.input.example is not None or job.structure is not None:
         _write(panel, "surface.obj", lambda p: write_surface(p, panel.mesh))
-    if result.converged:
-        _write_pattern_files(panel, job, material_scale, marks)
+    if result.converged or result.overlap is not None:
+        dxf = result.converged or job.output.allow_overlap
+        _write_pattern_files(panel, job, outcome.material.stiffness_scale, marks, dxf)
     data = summary(
         result, name=panel.name, input=job.input.to_dict(), tolerance=result.options.tolerance
     )
+    data["units"] = units_of(outcome)
     data["warnings"] = panel.warnings
+    data["repairs"] = outcome.repairs
     if job.structure is None:
         data["job_digest"] = job.digest()
     if panel.compensation is not None:
         data["compensation"] = panel.compensation.to_dict()
     _write(panel, "summary.json", lambda p: write_json(p, data))
+
+
+def units_of(outcome: JobOutcome) -> dict[str, str]:
+    """The units of a run's lengths, areas, stresses (force per length for thickness 1) and
+    energies, as summaries state them."""
+    length = outcome.units
+    if outcome.job.material.fabric is not None:
+        stress = "kN/m"  # the presets give E·t in kN/m
+        energy = f"kN/m·{length}²"
+    else:
+        stress = "the material's units (force per length with thickness 1)"
+        energy = f"stress × thickness × {length}²"
+    return {"length": length, "area": f"{length}²", "stress": stress, "energy": energy}
 
 
 def _write(panel: PanelOutcome, name: str, writer: Callable[[Path], None]) -> None:
@@ -112,14 +133,21 @@ def _write(panel: PanelOutcome, name: str, writer: Callable[[Path], None]) -> No
 
 
 def _write_pattern_files(
-    panel: PanelOutcome, job: Job, material_scale: float, marks: np.ndarray | None
+    panel: PanelOutcome, job: Job, material_scale: float, marks: np.ndarray | None, dxf: bool
 ) -> None:
     result, mesh = panel.result, panel.mesh
     x = result.material_coordinates
     _write(panel, "pattern.obj", lambda p: write_surface(p, mesh, x))
     _write(panel, "pattern.vtu", lambda p: write_surface(p, mesh, x, result.fields))
     _write(panel, "surface.vtu", lambda p: write_surface(p, mesh, fields=result.fields))
-    output = job.output
+    if dxf:
+        _write_dxf(panel, job, marks)
+    _write_drawings(panel, job, material_scale)
+
+
+def _write_dxf(panel: PanelOutcome, job: Job, marks: np.ndarray | None) -> None:
+    result, mesh, output = panel.result, panel.mesh, job.output
+    x = result.material_coordinates
     spacing = output.mark_spacing
     if marks is not None and spacing is None:
         spacing = STRUCTURE_MARK_SPACING
@@ -133,17 +161,17 @@ def _write_pattern_files(
             p,
             [piece],
             units=output.dxf_units,
-            model_units=job.input.units,
+            model_units=panel.units,
             allowance=output.allowance,
             mark_spacing=None if marks is not None else spacing,
         ),
     )
-    _write_drawings(panel, job, material_scale)
 
 
 def _label(panel: PanelOutcome, job: Job) -> list[str]:
     result = panel.result
-    label = [f"surface {panel.mesh.area:.4g} {job.input.units}², pattern {result.pattern_area:.4g}"]
+    units = panel.units
+    label = [f"surface {panel.mesh.area:.4g} {units}², pattern {result.pattern_area:.4g} {units}²"]
     if panel.compensation is not None and result.prestress is not None:
         c = panel.compensation
         label.append(
@@ -160,6 +188,7 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
 
     result, mesh = panel.result, panel.mesh
     x = result.material_coordinates
+    crossings = None if result.overlap is None else result.overlap.crossings
 
     def save(fig, names: tuple[str, ...]) -> None:
         for name in names:
@@ -170,14 +199,16 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
         plt.close(fig)
 
     save(
-        plot_pattern(mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern"),
+        plot_pattern(
+            mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern", marks=crossings
+        ),
         ("pattern.svg", "pattern.png"),
     )
     unit = "force/length" if result.thickness == 1.0 else "stress"
     scale = material_scale * result.thickness
     for name in job.output.plots:
         values = result.fields[name]
-        title = f"{panel.name}: {name}"
+        title = f"{panel.name}: {name} on the design shape"
         save(
             plot_pattern(
                 mesh,
@@ -202,7 +233,7 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
 def structure_marks(outcome: JobOutcome) -> list[np.ndarray]:
     """Matching marks of every panel, at the job's spacing (DXF units) along every seam."""
     job, structure = outcome.job, outcome.structure
-    factor = UNITS[job.input.units][0] / UNITS[job.output.dxf_units][0]
+    factor = METRES[outcome.units] / METRES[job.output.dxf_units]
     spacing = (job.output.mark_spacing or STRUCTURE_MARK_SPACING) / factor
     return seam_marks([r.material_coordinates for r in structure.results], structure.seams, spacing)
 
@@ -210,8 +241,9 @@ def structure_marks(outcome: JobOutcome) -> list[np.ndarray]:
 def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None:
     """``structure.json`` and (when it converged) ``structure.dxf``; paths to ``outcome.files``."""
     job, structure = outcome.job, outcome.structure
-    directory = job.directory
-    if structure.converged:
+    directory = outcome.directory
+    # marks exist when every panel converged or failed only by overlapping itself
+    if structure.converged or (job.output.allow_overlap and marks is not None):
         pieces = [
             CutPiece(
                 p.name,
@@ -227,7 +259,7 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
             directory / "structure.dxf",
             pieces,
             units=job.output.dxf_units,
-            model_units=job.input.units,
+            model_units=outcome.units,
             allowance=job.output.allowance,
         )
         outcome.files.append(directory / "structure.dxf")
@@ -249,12 +281,13 @@ def structure_summary(outcome: JobOutcome) -> dict:
         "energy_price": structure.energy_price,
         "elapsed_seconds": structure.elapsed,
         "job_digest": job.digest(),
+        "units": units_of(outcome),
         "options": structure.options.to_dict(),
         "material": {"law": type(outcome.material).__name__, **outcome.material.parameters},
         "panels": [
             {
                 "name": p.name,
-                "directory": str(p.directory),
+                "directory": os.path.relpath(p.directory, outcome.directory),
                 "cells": p.mesh.num_cells,
                 "surface_area": p.mesh.area,
                 "pattern_area": p.result.pattern_area,

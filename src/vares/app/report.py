@@ -13,6 +13,7 @@ import base64
 import datetime
 import html
 import io
+import os
 from pathlib import Path
 
 import numpy as np
@@ -21,9 +22,10 @@ from .._version import __version__
 from ..analysis.statistics import field_statistics
 from ..io.files import atomic_path
 from ..materials import Hyperelastic
-from ..mechanics.fields import KEY_FIELDS
+from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
 from .job import Job
 from .outcome import JobOutcome, PanelOutcome
+from .outputs import units_of
 
 __all__ = ["html_report", "structure_report", "write_reports"]
 
@@ -102,7 +104,7 @@ def _status(converged: bool, reason: str | None) -> str:
 
 
 def _input_section(outcome: PanelOutcome, job: Job) -> list[str]:
-    mesh, units = outcome.mesh, job.input.units
+    mesh, units = outcome.mesh, outcome.units
     cells = ", ".join(f"{len(c)} {t}" for t, c in mesh.cells.items())
     source = ", ".join(job.input.paths) or f"example {job.input.example}"
     rows = [
@@ -139,34 +141,47 @@ def _material_section(result, job: Job, material: Hyperelastic) -> list[str]:
     return ["<h2>Material and fibres</h2>", _table(rows, ident="material")]
 
 
-def _key_figures(outcome: PanelOutcome, units: str) -> list[str]:
+def _key_figures(outcome: PanelOutcome, unit_names: dict[str, str]) -> list[str]:
     result, mesh = outcome.result, outcome.mesh
+    units = unit_names["length"]
     key = [
         ("surface area", f"{_g(mesh.area)} {units}²"),
         ("pattern area", f"{_g(result.pattern_area)} {units}²"),
         ("pattern / surface area", f"{100 * (result.pattern_area / mesh.area - 1):+.3f} %"),
-        ("energy", _g(result.energy)),
+        ("energy", f"{_g(result.energy)} ({unit_names['energy']})"),
         ("Newton iterations", result.iterations),
         ("strategy", " → ".join(result.strategy)),
         ("initial guess", result.initial_guess),
         ("linear solver", result.linear_solver),
         ("time", f"{result.elapsed:.2f} s"),
     ]
-    if result.converged:
-        stats = field_statistics(result.fields)
-        for name in KEY_FIELDS:
-            s = stats[name]
-            key.append(
-                (f"{name} (min / mean / max)", f"{_g(s['min'])} / {_g(s['mean'])} / {_g(s['max'])}")
-            )
-        key.append(("wrinkling area", f"{100 * stats['wrinkling']['mean']:.1f} %"))
     parts = ["<h2>Key figures</h2>", _table(key, ident="key-figures")]
+    if not (result.converged or result.overlap is not None):
+        return parts
+    stats = field_statistics(result.fields)
+    rows = []
+    for name in KEY_FIELDS:
+        s = stats[name]
+        unit = _unit(name, unit_names)
+        rows.append((f"{name}{unit}", _g(s["min"]), _g(s["mean"]), _g(s["max"])))
+    parts += [
+        "<h2>Results on the design shape</h2>",
+        "<p>Stresses and stretches with the pattern forced exactly onto the design surface "
+        "(area-weighted means).</p>",
+        _table(rows, header=("field", "min", "mean", "max"), ident="fields"),
+    ]
     if outcome.compensation is not None and result.prestress is not None:
         parts += [
-            "<h2>Compensation and prestress</h2>",
+            f"<h2>Compensation and prestress on the design shape ({unit_names['stress']})</h2>",
             _table(outcome.compensation.rows(), header=("", "warp", "fill"), ident="compensation"),
         ]
     return parts
+
+
+def _unit(field: str, unit_names: dict[str, str]) -> str:
+    kind = FIELD_DESCRIPTIONS[field][1]
+    text = {"stress": unit_names["stress"], "degree": "°", "%": "%"}.get(kind)
+    return f" [{text}]" if text else ""
 
 
 def _convergence_section(result) -> list[str]:
@@ -204,11 +219,15 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
     result, mesh, fields = outcome.result, outcome.mesh, outcome.result.fields
     x = result.material_coordinates
     scale = material.stiffness_scale * result.thickness
+    crossings = None if result.overlap is None else result.overlap.crossings
+    caption = "the pattern with warp and fill"
+    if crossings is not None:
+        caption += f"; circled: where its outline crosses itself ({len(crossings)})"
     parts = [
         "<h2>Pattern</h2>",
         _figure(
-            plot_pattern(mesh, x, fibres=result.fibres, title="pattern"),
-            "the pattern with warp and fill",
+            plot_pattern(mesh, x, fibres=result.fibres, title="pattern", marks=crossings),
+            caption,
             "figure-pattern",
         ),
     ]
@@ -216,35 +235,37 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
         figure = plot_pattern(
             mesh, x, fields[name], field=name, fibres=result.fibres, title=name, stress_scale=scale
         )
-        parts.append(_figure(figure, f"{name} on the pattern", f"figure-{name}"))
+        caption = f"{name} on the pattern (on the design shape)"
+        parts.append(_figure(figure, caption, f"figure-{name}"))
     surface_det_f = plot_surface(mesh, fields["det_F"], field="det_F", title="det F")
     surface_warp = plot_surface(
         mesh, fields["warp_stress"], field="warp_stress", title="warp stress", stress_scale=scale
     )
     return [
         *parts,
-        "<h2>On the surface</h2>",
-        _figure(surface_det_f, "det F on the 3D surface", "figure-surface-det_F"),
-        _figure(surface_warp, "warp stress on the 3D surface", "figure-surface-warp_stress"),
+        "<h2>On the design surface</h2>",
+        _figure(surface_det_f, "det F on the design surface", "figure-surface-det_F"),
+        _figure(surface_warp, "warp stress on the design surface", "figure-surface-warp_stress"),
     ]
 
 
-def html_report(outcome: PanelOutcome, job: Job, material: Hyperelastic) -> str:
+def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
     """The report of one pattern of a job as one HTML document."""
-    result = outcome.result
+    job, material = outcome.job, outcome.material
+    result = panel.result
     parts = _page(
-        outcome.name,
-        f"Cutting pattern: {outcome.name}",
+        panel.name,
+        f"Cutting pattern: {panel.name}",
         _status(result.converged, result.reason),
-        outcome.warnings,
+        panel.warnings,
     )
-    parts += _input_section(outcome, job)
+    parts += _input_section(panel, job)
     parts += _material_section(result, job, material)
-    parts += _key_figures(outcome, job.input.units)
+    parts += _key_figures(panel, units_of(outcome))
     parts += _convergence_section(result)
-    if result.converged:
-        parts += _pattern_figures(outcome, material)
-    files = [(f.name, str(f)) for f in outcome.files]
+    if result.converged or result.overlap is not None:
+        parts += _pattern_figures(panel, material)
+    files = [(f.name, os.path.relpath(f, panel.directory)) for f in panel.files]
     parts += [
         "<h2>Files</h2>",
         _table(files, header=("file", "path"), ident="files"),
@@ -256,7 +277,7 @@ def html_report(outcome: PanelOutcome, job: Job, material: Hyperelastic) -> str:
 def structure_report(outcome: JobOutcome) -> str:
     """The report of a structure: status, panels (with links to their reports), seams."""
     structure = outcome.structure
-    units = outcome.job.input.units
+    units = outcome.units
     panels = [
         (
             p.name,
@@ -321,11 +342,11 @@ def write_reports(outcome: JobOutcome) -> None:
     the outcome's file lists."""
     for panel in outcome.panels:
         path = panel.directory / "report.html"
-        _write_text(path, html_report(panel, outcome.job, outcome.material))
+        _write_text(path, html_report(panel, outcome))
         panel.files.append(path)
         outcome.files.append(path)
     if outcome.structure is not None:
-        path = outcome.job.directory / "report.html"
+        path = outcome.directory / "report.html"
         _write_text(path, structure_report(outcome))
         outcome.files.append(path)
 

@@ -2,21 +2,23 @@
 
 The one runner behind ``vares pattern``, ``example``, ``run``, ``panels`` and ``batch``: every
 command builds a :class:`vares.app.job.Job` and hands it here, so they all get the same outputs
-(see :mod:`vares.app.outputs`).
+(see :mod:`vares.app.outputs`). Everything that can be checked is checked before the solve; the
+files of a run are staged and put in place as one set (:mod:`vares.app.staging`).
 """
 
 from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 
 from ..analysis.checks import pattern_warnings
 from ..analysis.compensation import compensation_report
 from ..geometry.examples import EXAMPLE_PLANES
 from ..geometry.mesh import SurfaceMesh
-from ..io.files import check_writable
+from ..io.files import check_writable, write_with
 from ..materials import Hyperelastic
-from ..solver import IterationRecord, PatternResult, solve
+from ..solver import IterationRecord, PatternResult, SolveOptions, solve
 from ..structures.matching import solve_structure
 from .inputs import Input, load_input
 from .job import Job, JobError
@@ -28,6 +30,7 @@ from .outputs import (
     write_panel,
     write_structure,
 )
+from .staging import OutputFolder
 
 __all__ = ["run_job"]
 
@@ -38,33 +41,85 @@ def run_job(
     force: bool = False,
     callback: Callable[[IterationRecord], None] | None = None,
     on_solve_start: Callable[[str, SurfaceMesh, Hyperelastic], None] | None = None,
+    save_job: Path | None = None,
 ) -> JobOutcome:
     """Run a job and write its files; returns what it did (also when the solve fails).
 
-    Every target is checked before the solve: an existing file is an error unless ``force``.
-    ``on_solve_start`` is told the name, mesh (the first panel's) and material before solving.
+    Before the solve: the material, the input and every target are checked (an existing run is
+    replaced only with ``force``; nothing else in the folder is ever lost). ``save_job``: also
+    write the job as TOML there (paths relative to it). ``on_solve_start`` is told the name,
+    mesh (the first panel's) and material before solving.
     """
     material = job.material.build(job.base)
     source = load_input(job)
-    check_writable(planned_files(job, source), force)
-    options = job.solve
-    if options.plane is None and job.input.example in EXAMPLE_PLANES:
-        options = options.replace(plane=EXAMPLE_PLANES[job.input.example])
+    folder = OutputFolder(
+        job.directory,
+        planned_files(job, source, save_job),
+        force=force,
+        inputs=_inputs(job),
+    )
+    folder.check()
+    if save_job is not None and save_job.resolve() not in folder.planned:
+        if save_job.resolve() in folder.inputs:
+            raise JobError(f"--save-job {save_job} is an input of the run")
+        check_writable([save_job], force)
     first = source.panels[0]
     if on_solve_start is not None:
         on_solve_start(first.name, first.mesh, material)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if job.structure is None:
-            outcome = _solve_one(job, source, material, options, callback)
-        else:
-            outcome = _solve_structure(job, source, material, options, callback)
-    outcome.warnings = [str(w.message) for w in caught] + outcome.warnings
+        outcome = _solve(job, source, material, _options(job), callback)
+    outcome.warnings = source.warnings + [str(w.message) for w in caught] + outcome.warnings
+    root = folder.start()
+    try:
+        _write(outcome, root, save_job, folder)
+        folder.commit()
+    finally:
+        folder.discard()
+    _moved(outcome, folder.directory, root)
+    if save_job is not None and save_job.resolve() not in folder.planned:
+        _save_job(job, save_job)
+        outcome.files.append(save_job)
+    return outcome
+
+
+def _inputs(job: Job) -> list[Path]:
+    paths = [job.path(p) for p in job.input.paths]
+    for extra in (job.material.presets, job.input.initial_pattern):
+        if extra is not None:
+            paths.append(job.path(extra))
+    if job.location is not None:
+        paths.append(job.location)
+    return paths
+
+
+def _options(job: Job) -> SolveOptions:
+    options = job.solve
+    if options.plane is None and job.input.example in EXAMPLE_PLANES:
+        options = options.replace(plane=EXAMPLE_PLANES[job.input.example])
+    return options
+
+
+def _solve(job: Job, source: Input, material, options, callback) -> JobOutcome:
+    if job.structure is None:
+        return _solve_one(job, source, material, options, callback)
+    return _solve_structure(job, source, material, options, callback)
+
+
+def _write(outcome: JobOutcome, root: Path, save_job: Path | None, folder: OutputFolder) -> None:
+    """Every file of the run, into ``root`` (the staging folder)."""
+    job = outcome.job
+    outcome.directory = root
     for panel in outcome.panels:
+        panel.directory = panel_directory(job, panel.name, root)
         panel.warnings = outcome.warnings + panel.warnings
-    marks = structure_marks(outcome) if outcome.structure and outcome.converged else None
+    marks = None
+    if outcome.structure is not None and all(
+        p.result.converged or p.result.overlap is not None for p in outcome.panels
+    ):
+        marks = structure_marks(outcome)
     for index, panel in enumerate(outcome.panels):
-        write_panel(panel, job, material.stiffness_scale, None if marks is None else marks[index])
+        write_panel(panel, outcome, None if marks is None else marks[index])
         outcome.files += panel.files
     if outcome.structure is not None:
         write_structure(outcome, marks)
@@ -72,13 +127,36 @@ def run_job(
         from .report import write_reports
 
         write_reports(outcome)
-    return outcome
+    if save_job is not None and save_job.resolve() in folder.planned:
+        staged = folder.staged(save_job)
+        _save_job(job, staged, location=save_job)
+        outcome.files.append(staged)
 
 
-def _panel(job: Job, name: str, mesh: SurfaceMesh, result: PatternResult) -> PanelOutcome:
+def _save_job(job: Job, path: Path, location: Path | None = None) -> None:
+    text = job.to_toml(location or path)
+    write_with(path, lambda p: p.write_text(text, encoding="utf-8"))
+
+
+def _moved(outcome: JobOutcome, directory: Path, root: Path) -> None:
+    """Point the outcome's paths from the staging folder to the output folder."""
+
+    def final(path: Path) -> Path:
+        return directory / Path(path).relative_to(root)
+
+    outcome.directory = directory
+    outcome.files = [final(p) for p in outcome.files]
+    for panel in outcome.panels:
+        panel.directory = final(panel.directory)
+        panel.files = [final(p) for p in panel.files]
+
+
+def _panel(
+    job: Job, source: Input, name: str, mesh: SurfaceMesh, result: PatternResult
+) -> PanelOutcome:
     slack = job.prestress.slack_threshold
     report = compensation_report(result, slack) if result.converged else None
-    panel = PanelOutcome(name, mesh, result, report, panel_directory(job, name))
+    panel = PanelOutcome(name, mesh, result, report, job.directory, source.units)
     panel.warnings = pattern_warnings(result, report)
     return panel
 
@@ -92,8 +170,15 @@ def _solve_one(job, source: Input, material, options, callback) -> JobOutcome:
         prestress=job.prestress.value(source.cell_data),
         options=options,
         callback=callback,
+        initial_guess=source.initial_pattern,
     )
-    return JobOutcome(job, material, [_panel(job, panel.name, panel.mesh, result)])
+    return JobOutcome(
+        job,
+        material,
+        [_panel(job, source, panel.name, panel.mesh, result)],
+        units=source.units,
+        repairs=source.repairs,
+    )
 
 
 def _solve_structure(job, source: Input, material, options, callback) -> JobOutcome:
@@ -108,13 +193,19 @@ def _solve_structure(job, source: Input, material, options, callback) -> JobOutc
         structure=job.structure,
         callback=callback,
     )
-    panels = [
-        _panel(job, p.name, p.mesh, r)
-        for p, r in zip(source.panels, structure.results, strict=True)
-    ]
+    pairs = zip(source.panels, structure.results, strict=True)
+    panels = [_panel(job, source, p.name, p.mesh, r) for p, r in pairs]
     too_wide = [
-        f"{name} is {width:.4g} {job.input.units} wide across the warp, more than the roll width "
+        f"{name} is {width:.4g} {source.units} wide across the warp, more than the roll width "
         f"{structure.structure_options.roll_width:g}"
         for name, width in structure.too_wide
     ]
-    return JobOutcome(job, material, panels, structure=structure, warnings=too_wide)
+    return JobOutcome(
+        job,
+        material,
+        panels,
+        structure=structure,
+        warnings=too_wide,
+        units=source.units,
+        repairs=source.repairs,
+    )

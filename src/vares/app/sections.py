@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.examples import EXAMPLES, STRUCTURE_EXAMPLES
-from ..io.dxf import UNITS
 from ..materials import LAWS, Hyperelastic, fabric, make_material
 from ..mechanics.fields import FIELD_DESCRIPTIONS
 from ..options import Options, OptionsError, option
+from ..units import METRES
 
 __all__ = ["InputOptions", "MaterialOptions", "OutputOptions", "PrestressOptions"]
 
@@ -52,8 +52,27 @@ class InputOptions(Options):
         section="input",
         choices=("triangle", "quad"),
     )
-    units: str = option(
-        "m", "str", "Units of the mesh coordinates.", section="input", choices=tuple(UNITS)
+    units: str | None = option(
+        None,
+        "str",
+        "Units of the mesh coordinates (default: those the file declares, as a Rhino model "
+        "does; else m).",
+        section="input",
+        choices=tuple(METRES),
+    )
+    repair: bool = option(
+        True,
+        "bool",
+        "Repair clear defects of the mesh (weld coincident nodes, drop collapsed and duplicate "
+        "cells, orient cells consistently); every change is reported.",
+        section="input",
+        flags=("--repair/--no-repair",),
+    )
+    initial_pattern: str | None = option(
+        None,
+        "path",
+        "A pattern file (same nodes and faces, e.g. an earlier pattern.obj) to start from.",
+        section="input",
     )
     name: str | None = option(
         None,
@@ -230,7 +249,7 @@ class OutputOptions(Options):
         False, "bool", "Also write report.html.", section="output", flags=("--report",)
     )
     dxf_units: str = option(
-        "mm", "str", "Units of the DXF drawing.", section="output", choices=tuple(UNITS)
+        "mm", "str", "Units of the DXF drawing.", section="output", choices=tuple(METRES)
     )
     allowance: float = option(
         0.0,
@@ -246,6 +265,14 @@ class OutputOptions(Options):
         f"{STRUCTURE_MARK_SPACING:g} unless given.",
         section="output",
         positive=True,
+    )
+    allow_overlap: bool = option(
+        False,
+        "bool",
+        "Write the DXF even of a pattern that overlaps itself (it is then no cut file: the "
+        "crossings are circled in the drawings).",
+        section="output",
+        flags=("--allow-overlap",),
     )
     plots: tuple[str, ...] = option(
         (),

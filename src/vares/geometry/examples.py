@@ -45,6 +45,7 @@ __all__ = [
     "irregular_hypar_strips",
     "rib30",
     "robustness_suite",
+    "ruffled_fan",
     "spherical_cap",
 ]
 
@@ -463,6 +464,30 @@ def _zip_columns(left, left_y, right, right_y) -> list[tuple[int, int, int]]:
     return out
 
 
+def ruffled_fan(
+    turn: float = 0.97,
+    waves: int = 5,
+    amplitude: float = 0.45,
+    n_radial: int = 6,
+    n_around: int = 120,
+) -> SurfaceMesh:
+    """A fan between radii 0.3 and 1 that goes ``turn`` × 360° around its axis while its rim
+    waves up and down (``z = amplitude · r · sin(waves ψ)``): a cone-like, developable surface
+    whose angle around the apex is far more than 360°. Its development laps over itself: no
+    pattern of it can be cut in one piece."""
+    r = np.linspace(0.3, 1.0, n_radial)
+    psi = np.linspace(0.0, 2.0 * np.pi * turn, n_around)
+    radius, angle = (a.ravel() for a in np.meshgrid(r, psi, indexing="xy"))
+    points = np.column_stack(
+        [
+            radius * np.cos(angle),
+            radius * np.sin(angle),
+            amplitude * radius * np.sin(waves * angle),
+        ]
+    )
+    return SurfaceMesh(points, grid_cells(n_radial, n_around))
+
+
 def robustness_suite(fine: bool = False) -> dict[str, Callable[[], SurfaceMesh]]:
     """The shipped set of hard and awkward surfaces every strategy change is checked on: steep
     and folding shapes, doubly curved ones of both signs, random bumps, graded cells and
@@ -486,6 +511,7 @@ def robustness_suite(fine: bool = False) -> dict[str, Callable[[], SurfaceMesh]]
         "cylinder 220°": lambda: cylinder160(
             angle=220.0, n_around=44 if fine else 22, n_along=16 if fine else 4
         ),
+        "steep saddle z = 2.5 xy": lambda: hypar(size=2.0, rise=2.5, n=20 if fine else 10),
         "rib30 (quads)": lambda: rib30(
             cell_type="quad", **({} if fine else {"spacing": 0.02, "fillet_segments": 3})
         ),

@@ -1,4 +1,5 @@
-"""Initial guesses: orthogonal projection onto a plane, or a conformal flattening (LSCM).
+"""Initial guesses: orthogonal projection onto a plane, a conformal flattening (LSCM), or
+Tutte's embedding, which never folds a disk.
 
 The plane also defines the pseudo-time path of DESIGN.md §1: ``x(τ) = P(x) + τ (x − P(x))``
 with ``P`` the orthogonal projection onto it, so that at ``τ = 0`` the projected coordinates
@@ -20,10 +21,12 @@ from .mesh import SurfaceMesh
 __all__ = [
     "PlaneSpec",
     "ProjectionPlane",
+    "inverted_cells",
     "lscm",
     "projection_distortion",
     "projection_plane",
     "signed_area",
+    "tutte",
 ]
 
 _NAMED_PLANES = {
@@ -191,6 +194,18 @@ def lscm(mesh: SurfaceMesh) -> np.ndarray:
     return coordinates * np.sqrt(mesh.area / flat_area)
 
 
+def inverted_cells(mesh: SurfaceMesh, coordinates: np.ndarray) -> np.ndarray:
+    """Global ids of the cells a pattern ``(n, 2)`` inverts or collapses (``det J ≤ 0`` at a
+    check point: a triangle's one value, a quad's corners)."""
+    out, offset = [], 0
+    for cell_type, cells in mesh.cells.items():
+        j = ELEMENTS[cell_type].jacobians(coordinates, cells, at="check")
+        det = j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
+        out.append(offset + np.flatnonzero(~(det > 0).all(axis=1)))
+        offset += len(cells)
+    return np.concatenate(out)
+
+
 def projection_distortion(mesh: SurfaceMesh, plane: ProjectionPlane) -> float:
     """Smallest ratio of projected to 3D area element over all cells (≤ 0 where it folds).
 
@@ -205,3 +220,92 @@ def projection_distortion(mesh: SurfaceMesh, plane: ProjectionPlane) -> float:
         det = j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
         ratios.append((det / element.corner_areas(mesh.points, cells)).ravel())
     return float(np.concatenate(ratios).min())
+
+
+def tutte(mesh: SurfaceMesh) -> np.ndarray:
+    """Tutte's embedding with mean-value weights (Floater 2003): one-to-one on any disk-like
+    triangle mesh, whatever its shape. Returns pattern coordinates ``(n, 2)``.
+
+    The outer boundary is laid on an ellipse shaped like the conformal map's boundary (its
+    principal axes and aspect), at positions proportional to the 3D arc length; every inner
+    node is the mean-value-weighted average of its neighbours (one sparse solve). Holes are
+    closed for the solve by a node at their centre joined to the hole's boundary. The result
+    keeps the cells' orientation and is scaled to the 3D area. Quads are split along a diagonal
+    for the weights; a strongly non-convex quad may still fold (it is checked by the caller).
+    """
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    loops = sorted(mesh.boundary_loops(), key=lambda loop: _loop_length(mesh.points, loop))
+    outer, holes = loops[-1], loops[:-1]
+    points, triangles = _closed_holes(mesh.points, _triangles(mesh), holes)
+    n = len(points)
+    rows, cols, weights = _mean_value_weights(points, triangles)
+    laplacian = sp.csr_matrix((weights, (rows, cols)), shape=(n, n))
+    laplacian = sp.diags(np.asarray(laplacian.sum(axis=1)).ravel()) - laplacian
+    boundary_xy = _ellipse(mesh, outer)
+    inner = np.setdiff1d(np.arange(n), outer)
+    rhs = -laplacian[inner][:, outer] @ boundary_xy
+    coordinates = np.empty((n, 2))
+    coordinates[outer] = boundary_xy
+    system = laplacian[inner][:, inner].tocsc()
+    coordinates[inner] = np.column_stack([spsolve(system, rhs[:, k]) for k in range(2)])
+    coordinates = coordinates[: mesh.num_points]
+    area = signed_area(mesh, coordinates)
+    if area < 0:
+        coordinates[:, 1] = -coordinates[:, 1]
+        area = -area
+    coordinates -= coordinates.mean(axis=0)
+    return coordinates * np.sqrt(mesh.area / area)
+
+
+def _loop_length(points: np.ndarray, loop: np.ndarray) -> float:
+    ring = points[np.append(loop, loop[0])]
+    return float(np.linalg.norm(np.diff(ring, axis=0), axis=1).sum())
+
+
+def _closed_holes(points, triangles, holes):
+    """Points and triangles with a node added at the centre of each hole, joined to it."""
+    extra_points, extra_triangles = [], []
+    for k, hole in enumerate(holes):
+        centre = len(points) + k
+        extra_points.append(points[hole].mean(axis=0))
+        # the hole's loop runs against the surrounding cells: close it the other way round
+        extra_triangles.append(
+            np.column_stack([np.roll(hole, -1), hole, np.full(len(hole), centre)])
+        )
+    if not holes:
+        return points, triangles
+    return np.vstack([points, extra_points]), np.vstack([triangles, *extra_triangles])
+
+
+def _mean_value_weights(points, triangles):
+    """``w_ij = (tan(α_i/2) + tan(β_i/2)) / |x_i − x_j|`` summed over the triangles at edge
+    ``ij`` (α, β the angles at ``i`` beside the edge): positive on any mesh."""
+    rows, cols, values = [], [], []
+    for k in range(3):
+        i, j, m = triangles[:, k], triangles[:, (k + 1) % 3], triangles[:, (k + 2) % 3]
+        a, b = points[j] - points[i], points[m] - points[i]
+        la, lb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
+        cosine = np.clip(np.einsum("ij,ij->i", a, b) / (la * lb), -1.0, 1.0)
+        half_tan = np.tan(0.5 * np.arccos(cosine))
+        rows += [i, i]
+        cols += [j, m]
+        values += [half_tan / la, half_tan / lb]
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(values)
+
+
+def _ellipse(mesh: SurfaceMesh, outer: np.ndarray) -> np.ndarray:
+    """Positions of the outer loop's nodes on an ellipse with the conformal boundary's axes."""
+    ring = mesh.points[np.append(outer, outer[0])]
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
+    angle = 2 * np.pi * arc[:-1] / arc[-1]
+    try:
+        shape = lscm(mesh)[outer]
+    except (ValueError, RuntimeError):
+        shape = mesh.points[outer][:, :2]
+    centred = shape - shape.mean(axis=0)
+    _, spread, axes = np.linalg.svd(centred, full_matrices=False)
+    ratio = spread[1] / spread[0] if spread[0] > 0 else 1.0
+    ratio = max(ratio, 0.05)  # a very thin ellipse would squeeze the inner nodes together
+    return np.column_stack([np.cos(angle), ratio * np.sin(angle)]) @ axes

@@ -18,7 +18,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .elements import ELEMENTS
 
-__all__ = ["MeshError", "SurfaceMesh"]
+__all__ = ["MeshError", "SurfaceMesh", "connected_pieces"]
 
 
 class MeshError(ValueError):
@@ -166,6 +166,24 @@ class SurfaceMesh:
         edges, _, counts = self._edge_table()
         return edges[counts == 1]
 
+    def boundary_loops(self) -> list[np.ndarray]:
+        """Closed node loops of the boundary, longest (most nodes) first, each in cell
+        orientation (counter-clockwise for the outer loop of a positively oriented pattern)."""
+        following = {int(a): int(b) for a, b in self.boundary_edges()}
+        loops, seen = [], set()
+        for start in sorted(following):
+            if start in seen:
+                continue
+            loop = [start]
+            seen.add(start)
+            node = following[start]
+            while node != start:
+                loop.append(node)
+                seen.add(node)
+                node = following[node]
+            loops.append(np.array(loop))
+        return sorted(loops, key=len, reverse=True)
+
     def transformed(self, points: np.ndarray) -> SurfaceMesh:
         """The same topology with new node coordinates ``(n, 3)``."""
         return SurfaceMesh(points, self._cells)
@@ -271,9 +289,9 @@ class SurfaceMesh:
         if num_pieces > 1:
             sizes = np.bincount(label)
             raise MeshError(
-                f"the mesh has {num_pieces} disconnected pieces (cells per piece: "
-                f"{_listing(sizes)}); pattern each piece separately (one file per panel: "
-                "'vares panels a.obj b.obj …')"
+                f"the mesh has {num_pieces} separate pieces (cells per piece: "
+                f"{_listing(sizes)}); pattern them as the panels of a structure: "
+                "'vares panels FILE' takes each piece as a panel"
             )
 
         self._check_manifold_vertices(directed, owner, edge_id)
@@ -319,3 +337,29 @@ class SurfaceMesh:
                 "each of them form "
                 "separate fans that touch only at the node"
             )
+
+
+def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.ndarray:
+    """The piece (0, 1, …) of every cell (global cell order): cells are in one piece when a
+    chain of shared edges joins them; the largest piece is 0."""
+    directed, owner = [], []
+    offset = 0
+    for block in cells.values():
+        nen = block.shape[1]
+        for i in range(nen):
+            directed.append(np.column_stack([block[:, i], block[:, (i + 1) % nen]]))
+            owner.append(offset + np.arange(len(block)))
+        offset += len(block)
+    key = np.sort(np.vstack(directed), axis=1)
+    owner = np.concatenate(owner)
+    _, edge_id = np.unique(key, axis=0, return_inverse=True)
+    edge_id = edge_id.ravel()
+    graph = sp.coo_matrix(
+        (np.ones(owner.size), (owner, edge_id)), shape=(offset, edge_id.max() + 1)
+    )
+    adjacency = (graph @ graph.T).tocsr()
+    _, label = connected_components(adjacency, directed=False)
+    sizes = np.bincount(label)
+    rank = np.empty_like(sizes)
+    rank[np.argsort(-sizes, kind="stable")] = np.arange(sizes.size)
+    return rank[label]

@@ -20,12 +20,13 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
+from ..units import METRES
 from .files import atomic_path
 
-__all__ = ["UNITS", "CutPiece", "boundary_loops", "cut_outline", "write_dxf"]
+__all__ = ["INSUNITS", "CutPiece", "cut_outline", "write_dxf"]
 
-#: DXF units: name → (metres per unit, $INSUNITS code).
-UNITS = {"mm": (1e-3, 4), "cm": (1e-2, 5), "m": (1.0, 6)}
+#: DXF ``$INSUNITS`` code of each length unit.
+INSUNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1, "ft": 2}
 LAYERS = {"SEAM": 7, "CUT": 1, "WARP": 5, "MARKS": 3, "LABEL": 2}
 
 
@@ -41,26 +42,6 @@ class CutPiece:
     warp: np.ndarray | None = None
     label: Sequence[str] = ()
     marks: np.ndarray | None = field(default=None, repr=False)
-
-
-def boundary_loops(mesh: SurfaceMesh) -> list[np.ndarray]:
-    """Closed node loops of the mesh boundary, longest first, each in cell orientation
-    (counter-clockwise for the outer loop of a positively oriented pattern)."""
-    edges = mesh.boundary_edges()
-    following = {int(a): int(b) for a, b in edges}
-    loops, seen = [], set()
-    for start in sorted(following):
-        if start in seen:
-            continue
-        loop = [start]
-        seen.add(start)
-        node = following[start]
-        while node != start:
-            loop.append(node)
-            seen.add(node)
-            node = following[node]
-        loops.append(np.array(loop))
-    return sorted(loops, key=len, reverse=True)
 
 
 def _signed_area(ring: np.ndarray) -> float:
@@ -120,16 +101,18 @@ def write_dxf(
     """
     import ezdxf
 
-    if units not in UNITS or model_units not in UNITS:
-        raise ValueError(f"units must be one of {', '.join(UNITS)}; got {units!r}/{model_units!r}")
+    if units not in INSUNITS or model_units not in INSUNITS:
+        raise ValueError(
+            f"units must be one of {', '.join(INSUNITS)}; got {units!r}/{model_units!r}"
+        )
     if not (np.isfinite(allowance) and allowance >= 0):
         raise ValueError(f"the seam allowance must be ≥ 0; got {allowance!r}")
     if mark_spacing is not None and not (np.isfinite(mark_spacing) and mark_spacing > 0):
         raise ValueError(f"the match mark spacing must be > 0; got {mark_spacing!r}")
-    factor = UNITS[model_units][0] / UNITS[units][0]
+    factor = METRES[model_units] / METRES[units]
 
     doc = ezdxf.new("R2010", setup=True)
-    doc.header["$INSUNITS"] = UNITS[units][1]
+    doc.header["$INSUNITS"] = INSUNITS[units]
     doc.header["$MEASUREMENT"] = 1
     for name, colour in LAYERS.items():
         doc.layers.add(name, color=colour)
@@ -138,7 +121,7 @@ def write_dxf(
     cursor = 0.0
     for piece in pieces:
         coordinates = np.asarray(piece.coordinates, dtype=float) * factor
-        seams = [coordinates[loop] for loop in boundary_loops(piece.mesh)]
+        seams = [coordinates[loop] for loop in piece.mesh.boundary_loops()]
         cuts = cut_outline(seams, allowance)
         everything = np.vstack(cuts + seams)
         low, high = everything.min(axis=0), everything.max(axis=0)

@@ -7,26 +7,122 @@ import contextlib
 import io
 import itertools
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..geometry.elements import ELEMENTS
-from ..geometry.mesh import MeshError, SurfaceMesh
+from ..geometry.mesh import MeshError, SurfaceMesh, connected_pieces
+from ..geometry.repair import RepairReport
+from ..geometry.repair import repair as repair_surface
 from .files import write_with
+from .formats import read_obj, read_off
 
-__all__ = ["read_mesh", "read_mesh_data", "read_pattern", "write_surface"]
+__all__ = [
+    "MeshFile",
+    "RawSurface",
+    "read_mesh",
+    "read_mesh_data",
+    "read_mesh_file",
+    "read_pattern",
+    "read_raw",
+    "write_surface",
+]
 
 #: Cell types of meshio that are ignored when reading a surface (lower-dimensional helpers).
 _IGNORED_CELL_TYPES = {"vertex", "line", "line3"}
 
 
-def read_mesh(path: str | Path) -> SurfaceMesh:
-    """Read a surface mesh from any format meshio reads (OBJ, STL, PLY, VTK/VTU, Gmsh, …) or
-    from a Rhino ``.3dm`` file holding one mesh (see :mod:`vares.rhino`).
+@dataclass
+class RawSurface:
+    """A file's points and faces as stored (no repair), its cell data (by face, in the order
+    triangles, quads, polygons), the length units it declares, and the resolution of its
+    coordinates (the spacing of single precision numbers at its largest coordinate; 0 when
+    stored in double precision or as text)."""
 
-    Triangle and quad cells are kept; vertex and line cells (boundary markers in many
-    formats) are ignored. Nodes that belong to no cell are dropped with a warning.
+    points: np.ndarray
+    cells: dict[str, np.ndarray]
+    polygons: list[np.ndarray] = field(default_factory=list)
+    cell_data: dict[str, np.ndarray] = field(default_factory=dict)
+    units: str | None = None
+    resolution: float = 0.0
+
+
+@dataclass
+class MeshFile:
+    """A mesh file, read and repaired: the points and cells, the cell data of the kept cells,
+    the declared units, the coordinates' resolution and what the repair changed."""
+
+    path: Path
+    points: np.ndarray
+    cells: dict[str, np.ndarray]
+    cell_data: dict[str, np.ndarray]
+    units: str | None
+    resolution: float
+    repair: RepairReport
+
+    def surface(self) -> SurfaceMesh:
+        """The surface, validated (a :class:`MeshError` names what is wrong and where)."""
+        try:
+            return SurfaceMesh(self.points, self.cells)
+        except MeshError as exc:
+            raise MeshError(f"{self.path}: {exc}") from None
+
+    def pieces(self) -> list[tuple[SurfaceMesh, np.ndarray]]:
+        """The connected pieces of the mesh, each validated, with the global ids of its cells."""
+        ids = connected_pieces(self.points, self.cells)
+        out = []
+        bounds = np.cumsum([0] + [len(c) for c in self.cells.values()])
+        for piece in range(ids.max() + 1):
+            cells, kept = {}, []
+            for (cell_type, block), a, b in zip(
+                self.cells.items(), bounds[:-1], bounds[1:], strict=True
+            ):
+                mine = ids[a:b] == piece
+                if mine.any():
+                    cells[cell_type] = block[mine]
+                    kept.append(np.flatnonzero(mine) + a)
+            used = np.unique(np.concatenate([c.ravel() for c in cells.values()]))
+            renumber = np.full(len(self.points), -1)
+            renumber[used] = np.arange(used.size)
+            try:
+                mesh = SurfaceMesh(self.points[used], {t: renumber[c] for t, c in cells.items()})
+            except MeshError as exc:
+                raise MeshError(f"{self.path}: piece {piece + 1}: {exc}") from None
+            out.append((mesh, np.concatenate(kept)))
+        return out
+
+    def precision_warning(self) -> str | None:
+        """A sentence when the stored precision is coarse for the mesh's edges, else ``None``."""
+        if self.resolution <= 0:
+            return None
+        edges = [
+            np.linalg.norm(self.points[c] - self.points[np.roll(c, -1, axis=1)], axis=-1).ravel()
+            for c in self.cells.values()
+        ]
+        mean_edge = float(np.mean(np.concatenate(edges)))
+        if self.resolution <= COARSE_PRECISION * mean_edge:
+            return None
+        return (
+            f"{self.path.name} stores coordinates in single precision up to "
+            f"{np.abs(self.points).max():.3g} from the origin: they are only known to "
+            f"{self.resolution:.3g} ({100 * self.resolution / mean_edge:.2g} % of the mean edge "
+            "length); export in double precision or move the model near the origin"
+        )
+
+
+#: Coordinates resolved more coarsely than this fraction of the mean edge length are warned of.
+COARSE_PRECISION = 1e-4
+
+
+def read_mesh(path: str | Path) -> SurfaceMesh:
+    """Read a surface mesh: OBJ, OFF (polygons too), STL, PLY, VTK/VTU, Gmsh and any other
+    format meshio reads, or a Rhino ``.3dm`` file holding one mesh (see :mod:`vares.io.rhino`).
+
+    The clear repairs of :func:`vares.geometry.repair.repair` are made (welding coincident
+    nodes, dropping collapsed cells, orienting cells consistently, triangulating polygons);
+    vertex and line cells are ignored.
 
     Raises
     ------
@@ -39,29 +135,62 @@ def read_mesh(path: str | Path) -> SurfaceMesh:
 
 
 def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]]:
-    """:func:`read_mesh`, and the file's cell data in the mesh's global cell order.
+    """:func:`read_mesh`, and the file's cell data in the mesh's global cell order. What the
+    repair changed is said in a warning."""
+    mesh_file = read_mesh_file(path)
+    if mesh_file.repair.changed:
+        warnings.warn(
+            f"repaired {mesh_file.path.name}: {'; '.join(mesh_file.repair.actions())}",
+            stacklevel=2,
+        )
+    return mesh_file.surface(), mesh_file.cell_data
 
-    Each cell data array has shape ``(num_cells,)`` or ``(num_cells, k)``; arrays that exist
-    only on some cell blocks are left out.
-    """
-    import meshio
 
+def read_mesh_file(path: str | Path, *, repair: bool = True) -> MeshFile:
+    """Read and (unless ``repair`` is false) repair a mesh file; see :class:`MeshFile`."""
+    path = Path(path)
+    raw = read_raw(path)
+    fixed = repair_surface(raw.points, raw.cells, raw.polygons, weld=repair)
+    cell_data = {name: np.asarray(values)[fixed.cell_map] for name, values in raw.cell_data.items()}
+    return MeshFile(
+        path, fixed.points, fixed.cells, cell_data, raw.units, raw.resolution, fixed.report
+    )
+
+
+def read_raw(path: Path) -> RawSurface:
+    """The points, faces and cell data of a file as stored (see :class:`RawSurface`)."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
     if path.stat().st_size == 0:
         raise MeshError(f"{path} is empty")
-    if path.suffix.lower() == ".3dm":
-        from .rhino import read_3dm
+    suffix = path.suffix.lower()
+    if suffix == ".3dm":
+        return _read_3dm(path)
+    if suffix in (".obj", ".off"):
+        soup = read_obj(path) if suffix == ".obj" else read_off(path)
+        return RawSurface(soup.points, soup.cells, soup.polygons)
+    return _read_meshio(path)
 
-        meshes = read_3dm(path)
-        if len(meshes) > 1:
-            names = ", ".join(m.name for m in meshes)
-            raise MeshError(
-                f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels "
-                "('vares panels')"
-            )
-        return meshes[0].mesh, {}
+
+def _read_3dm(path: Path) -> RawSurface:
+    from .rhino import read_3dm, unit_system
+
+    meshes = read_3dm(path)
+    if len(meshes) > 1:
+        names = ", ".join(m.name for m in meshes)
+        raise MeshError(
+            f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels ('vares panels')"
+        )
+    mesh = meshes[0].mesh
+    units = unit_system(path)
+    resolution = float(np.spacing(np.float32(np.abs(mesh.points).max())))
+    return RawSurface(np.array(mesh.points), mesh.cells, units=units, resolution=resolution)
+
+
+def _read_meshio(path: Path) -> RawSurface:
+    import meshio
+
     chatter = io.StringIO()  # some readers print their complaints: keep them for the error
     try:
         with (
@@ -77,30 +206,41 @@ def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]
         detail = chatter.getvalue().strip().splitlines()
         reason = detail[-1] if detail else f"{type(exc).__name__}: {exc}"
         raise MeshError(f"cannot read {path}: {reason}") from None
-
     cells: dict[str, list[np.ndarray]] = {}
+    polygons: list[np.ndarray] = []
     data: dict[str, dict[str, list[np.ndarray]]] = {}
     for index, block in enumerate(raw.cells):
         if block.type in _IGNORED_CELL_TYPES:
             continue
-        if block.type not in ELEMENTS:
+        kind = "polygon" if block.type.startswith("polygon") else block.type
+        if kind not in (*ELEMENTS, "polygon"):
             raise MeshError(
                 f"{path} contains {block.type!r} cells; vares needs a surface mesh of "
-                "triangles and/or quads"
+                "triangles, quads or polygons"
             )
-        cells.setdefault(block.type, []).append(np.asarray(block.data))
+        if kind == "polygon":
+            polygons.extend(np.asarray(block.data))
+        else:
+            cells.setdefault(kind, []).append(np.asarray(block.data))
         for name, arrays in raw.cell_data.items():
-            data.setdefault(name, {}).setdefault(block.type, []).append(np.asarray(arrays[index]))
-    if not cells:
+            data.setdefault(name, {}).setdefault(kind, []).append(np.asarray(arrays[index]))
+    if not cells and not polygons:
         raise MeshError(f"{path} contains no triangle or quad cells")
-    mesh = SurfaceMesh(
-        raw.points, {t: np.vstack(blocks) for t, blocks in cells.items()}, drop_unused_nodes=True
-    )
+    blocks = {t: np.vstack(b) for t, b in cells.items()}
+    counts = {**{t: len(b) for t, b in blocks.items()}, "polygon": len(polygons)}
     cell_data = {}
     for name, by_type in data.items():
-        if all(len(by_type.get(t, [])) == len(cells[t]) for t in cells):
-            cell_data[name] = np.concatenate([np.concatenate(by_type[t]) for t in cells])
-    return mesh, cell_data
+        if all(sum(len(a) for a in by_type.get(t, [])) == n for t, n in counts.items() if n):
+            cell_data[name] = np.concatenate(
+                [np.concatenate(by_type[t]) for t in counts if counts[t]]
+            )
+    points = np.asarray(raw.points)
+    resolution = 0.0
+    if points.dtype == np.float32 and points.size:
+        resolution = float(np.spacing(np.abs(points).max()))
+    if points.ndim == 2 and points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+    return RawSurface(points.astype(float), blocks, polygons, cell_data, resolution=resolution)
 
 
 def write_surface(
@@ -134,26 +274,17 @@ def write_surface(
 
 
 def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
-    """Pattern coordinates ``(n, 2)`` from a file written by :func:`write_surface` for ``mesh``.
-
-    The file must have the same cells as ``mesh`` (same nodes and faces) and lie in z = 0.
-    """
-    import meshio
-
+    """Pattern coordinates ``(n, 2)`` from a file with the nodes and faces of ``mesh`` (as
+    :func:`write_surface` writes it), lying in a plane z = const."""
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no such file: {path}")
-    try:
-        raw = meshio.read(path)
-    except Exception as exc:
-        raise MeshError(f"cannot read {path}: {type(exc).__name__}: {exc}") from exc
-    cells = {b.type: b.data for b in raw.cells if b.type in mesh.cells}
+    raw = read_raw(path)
     same = len(raw.points) == mesh.num_points and all(
-        t in cells and np.array_equal(cells[t], c) for t, c in mesh.cells.items()
+        t in raw.cells and np.array_equal(raw.cells[t], c) for t, c in mesh.cells.items()
     )
     if not same:
         raise MeshError(f"{path} does not have the nodes and faces of the surface mesh")
     points = np.asarray(raw.points, dtype=float)
-    if points.shape[1] == 3 and np.abs(points[:, 2]).max(initial=0.0) > 1e-9 * np.ptp(points):
-        raise MeshError(f"{path} is not flat (z ≠ 0): not a pattern")
+    height = np.ptp(points[:, 2]) if points.shape[1] == 3 else 0.0
+    if height > 1e-9 * np.ptp(points[:, :2]):
+        raise MeshError(f"{path} is not flat (its z varies): not a pattern")
     return points[:, :2].copy()

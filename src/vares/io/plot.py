@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.collections import PolyCollection
+from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import Normalize, TwoSlopeNorm
 
 from ..geometry.mesh import SurfaceMesh
@@ -93,7 +93,7 @@ def _colour_scale(values, field, value_range, stress_scale):
         low, high = middle - 0.5 * span, middle + 0.5 * span
     centre = _CENTRED.get(field)
     if centre is not None and low < centre < high:
-        return TwoSlopeNorm(centre, low, high), "RdBu_r"
+        return TwoSlopeNorm(centre, low, high), "coolwarm"  # grey, not white, at the centre
     return Normalize(low, high if high > low else low + 1e-12), "viridis"
 
 
@@ -114,12 +114,14 @@ def plot_pattern(
     value_range: Sequence[float] | None = None,
     edges: bool = False,
     stress_scale: float | None = None,
+    marks: np.ndarray | None = None,
 ) -> plt.Figure:
     """Draw a pattern ``(n, 2)``, optionally coloured by per-cell ``values`` (global order).
 
     ``field`` names the values (for the colour bar label and a centred colour scale); ``fibres``
     draws warp (solid) and fill (dashed) arrows; ``value_range`` fixes the colour scale;
-    ``stress_scale`` (e.g. the material's stiffness) sets the round-off level of stress fields.
+    ``stress_scale`` (e.g. the material's stiffness) sets the round-off level of stress fields;
+    ``marks`` ``(k, 2)`` are circled in red (where the outline crosses itself).
     """
     if ax is None:
         width, height = np.ptp(coordinates, axis=0)
@@ -130,7 +132,7 @@ def plot_pattern(
     polygons = _polygons(mesh, coordinates)
     if values is None:
         collection = PolyCollection(
-            polygons, facecolors="#d9e6f2", edgecolors="#5b7a99", linewidths=0.2
+            polygons, facecolors="#d9e6f2", edgecolors="#5b7a99", linewidths=0.2, rasterized=True
         )
         ax.add_collection(collection)
     else:
@@ -143,13 +145,15 @@ def plot_pattern(
             norm=norm,
             edgecolors="k" if edges else "face",
             linewidths=0.1 if edges else 0.3,
+            rasterized=True,  # vector drawings keep the outline and arrows, cells as an image
         )
         ax.add_collection(collection)
         label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
         fig.colorbar(collection, ax=ax, label=label, shrink=0.85)
     boundary = mesh.boundary_edges()
-    for a, b in boundary:
-        ax.plot(*coordinates[[a, b]].T, color="k", linewidth=0.6)
+    ax.add_collection(LineCollection(coordinates[boundary], colors="k", linewidths=0.6))
+    if marks is not None and len(marks):
+        ax.plot(*np.asarray(marks).T, "o", mfc="none", mec="red", ms=9, mew=1.5, ls="none")
     if fibres is not None:
         centre = coordinates.mean(axis=0)
         size = 0.15 * np.ptp(coordinates, axis=0).max()
@@ -200,7 +204,15 @@ def plot_surface(
     else:
         values = np.asarray(values, dtype=float)
         norm, cmap = _colour_scale(values, field, None, stress_scale)
-        collection = Poly3DCollection(polygons, array=values, cmap=cmap, norm=norm, linewidths=0.0)
+        collection = Poly3DCollection(
+            polygons,
+            array=values,
+            cmap=cmap,
+            norm=norm,
+            edgecolors=(0.25, 0.25, 0.25, 0.25),  # the shape shows whatever the colours
+            linewidths=0.15,
+            rasterized=True,
+        )
         label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
         fig.colorbar(collection, ax=ax, label=label, shrink=0.7)
     ax.add_collection3d(collection)

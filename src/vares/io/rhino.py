@@ -15,7 +15,16 @@ import numpy as np
 
 from ..geometry.mesh import MeshError, SurfaceMesh
 
-__all__ = ["NamedMesh", "read_3dm", "write_3dm"]
+__all__ = ["NamedMesh", "read_3dm", "unit_system", "write_3dm"]
+
+#: Rhino unit systems and vares' names for them.
+_UNITS = {
+    "Millimeters": "mm",
+    "Centimeters": "cm",
+    "Meters": "m",
+    "Inches": "in",
+    "Feet": "ft",
+}
 
 
 @dataclass(frozen=True)
@@ -116,11 +125,34 @@ def read_3dm(path: str | Path) -> list[NamedMesh]:
     return out
 
 
-def write_3dm(path: str | Path, meshes: list[NamedMesh]) -> None:
-    """Write meshes to a Rhino file, each as a named object on a layer of its own name."""
+def unit_system(path: str | Path) -> str | None:
+    """The length unit a Rhino file declares (``"mm"``, ``"m"`` …), ``None`` when it declares
+    none; a unit vares does not know is a :class:`MeshError`."""
+    import rhino3dm
+
+    model = rhino3dm.File3dm.Read(str(path))
+    if model is None:
+        raise MeshError(f"cannot read {path}: not a Rhino 3dm file, or a damaged one")
+    system = model.Settings.ModelUnitSystem.name
+    if system in ("None", "Unset"):
+        return None
+    if system not in _UNITS:
+        raise MeshError(
+            f"{path} is modelled in {system}; vares takes "
+            f"{', '.join(_UNITS)}: change the model's units in Rhino"
+        )
+    return _UNITS[system]
+
+
+def write_3dm(path: str | Path, meshes: list[NamedMesh], units: str | None = None) -> None:
+    """Write meshes to a Rhino file, each as a named object on a layer of its own name, in the
+    given length units (``"mm"``, ``"m"`` …; Rhino's default when None)."""
     import rhino3dm
 
     model = rhino3dm.File3dm()
+    if units is not None:
+        names = {v: k for k, v in _UNITS.items()}
+        model.Settings.ModelUnitSystem = getattr(rhino3dm.UnitSystem, names[units])
     layer_index: dict[str, int] = {}
     for named in meshes:
         layer_name = named.layer or named.name

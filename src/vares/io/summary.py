@@ -57,6 +57,7 @@ def summary(result: PatternResult, **extra: object) -> dict:
         "warp_deviation_degrees": result.warp_deviation,
     }
     if result.converged:
+        out["fields_on"] = "the design shape: the pattern forced exactly onto the surface"
         out["fields"] = field_statistics(result.fields)
     out["history"] = [
         {

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..geometry.elements import ELEMENTS
+from ..geometry.flatten import inverted_cells
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic, MaterialError
 from .kernels import block_energy, determinant, projected_hessian
@@ -77,11 +78,13 @@ class Problem:
         self.thickness = float(thickness)
         self.fibres = fibres
         self.points = mesh.points if points is None else np.asarray(points, dtype=float)
+        # the metric is translation invariant: recentred, far-off site coordinates lose nothing
+        centred = self.points - self.points.mean(axis=0)
         self.prestress = prestress_components(prestress, mesh.num_cells)
         if self.prestress is not None and fibres is None:
             raise ValueError("a prestress along the yarns needs fibre directions")
         self._prestress_blocks = self._split_prestress(self.prestress)
-        self._metrics = [ELEMENTS[t].metrics(self.points, cells) for t, cells in mesh.cells.items()]
+        self._metrics = [ELEMENTS[t].metrics(centred, cells) for t, cells in mesh.cells.items()]
 
     def _split_prestress(self, components: np.ndarray | None) -> list[np.ndarray | None]:
         """``S_pre`` per block, broadcastable to ``(m, q, 2, 2)``."""
@@ -174,11 +177,7 @@ class Problem:
 
     def inverted_cells(self, coordinates: np.ndarray) -> np.ndarray:
         """Global ids of the cells with ``det J ≤ 0`` somewhere (inverted or collapsed)."""
-        out, offset = [], 0
-        for det in self.jacobian_determinants(coordinates):
-            out.append(offset + np.flatnonzero(~(det > 0).all(axis=1)))
-            offset += len(det)
-        return np.concatenate(out)
+        return inverted_cells(self.mesh, coordinates)
 
     def admissible_step(self, coordinates: np.ndarray, delta: np.ndarray) -> float:
         """Largest ``α`` such that ``coordinates + α delta`` keeps every ``det J`` positive

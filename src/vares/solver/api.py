@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from ..geometry.flatten import tutte
+from ..geometry.injectivity import Overlap, pattern_overlap
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic
 from ..mechanics.assembly import Assembler
@@ -74,76 +76,141 @@ def solve(
     Returns
     -------
     PatternResult
-        Always returned; ``converged`` and ``reason`` tell whether and why not.
+        Always returned; ``converged`` and ``reason`` tell whether and why not. A pattern that
+        overlaps itself (its outline crosses itself) is not converged: ``overlap`` says where.
     """
     given = settings.pop("initial_guess", None)
     if given is not None and isinstance(given, str):
         settings["initial_guess"], given = given, None
     (options,) = split_settings(settings, [options or SolveOptions()])
     started = time.perf_counter()
-    fibres = Fibres.from_angles(options.warp_angle, options.fill_angle)
-
-    def make_problem(fibres: Fibres) -> Problem:
-        return Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)
-
-    problem = make_problem(fibres)
+    run = _Run(mesh, material, thickness, prestress, options, callback)
     start = initial_guess(mesh, options, given)
-    direction = None if options.warp_direction is None else np.array(options.warp_direction)
-    rotation = options.orientation if problem.orientation_matters else "fixed"
-    free, constraint = rigid_modes(start.coordinates, rotation)
-    ctx = NewtonContext(
-        assembler=Assembler(mesh, free),
-        linear_solver=get_solver(options.linear_solver),
-        residual_tolerance=options.tolerance * problem.force_scale,
-        energy_noise=ENERGY_NOISE * material.stiffness_scale * problem.thickness * mesh.area,
-        force_scale=problem.force_scale,
-        max_iterations=options.max_iterations,
-        history=[],
-        steps=[],
-        callback=callback,
-        constraint=constraint,
-    )
-    path: list[str] = []
-    x, deviation = start.coordinates, None
-    reason = _folded_start(problem, start)
-    if reason is None:
-        if direction is not None:
-            fibres = initial_fibres(fibres, options.warp_angle, x, problem, direction)
-            problem = make_problem(fibres)
-        attempts = plan(options.strategy, options.steps, start.plane is not None)
-        x, path, reason = follow_plan(problem, x, start.plane, attempts, ctx, options.damping)
-        if reason is None and direction is not None:
-            path.append("warp alignment")
-            try:
-                x, fibres, deviation = align_warp(
-                    make_problem, x, fibres, direction, ctx, options.damping
-                )
-            except Failure as failure:
-                reason, x = failure.reason, failure.coordinates
-            x, fibres = _warp_along_x(x, fibres, ctx)
-            problem = make_problem(fibres)
+    attempt = run.attempt(start)
+    if attempt.overlap is not None and options.initial_guess == "auto" and start.kind != "tutte":
+        # a start that is not one-to-one can lead to a minimum whose outline laps over itself;
+        # Tutte's embedding starts on the right side of every fold
+        retry = run.attempt(Start(tutte(mesh), "tutte", None), restart=True)
+        if retry.reason is None or retry.energy < attempt.energy:
+            attempt = retry
     return PatternResult(
         mesh=mesh,
         material=material,
-        thickness=problem.thickness,
-        material_coordinates=x,
-        converged=reason is None,
-        reason=reason,
-        energy=problem.energy(x),
-        history=ctx.history,
-        steps=ctx.steps,
-        strategy=path,
-        linear_solver=ctx.linear_solver.name,
+        thickness=attempt.problem.thickness,
+        material_coordinates=attempt.coordinates,
+        converged=attempt.reason is None,
+        reason=attempt.reason,
+        energy=attempt.energy,
+        history=run.history,
+        steps=run.steps,
+        strategy=run.path,
+        linear_solver=run.solver_name,
         elapsed=time.perf_counter() - started,
         options=options,
-        fibres=fibres,
-        prestress=problem.prestress,
-        plane=start.plane,
-        orientation="direction" if direction is not None else rotation,
-        initial_guess=start.kind,
-        warp_direction=direction,
-        warp_deviation=None if deviation is None else float(np.degrees(deviation)),
+        fibres=attempt.fibres,
+        prestress=attempt.problem.prestress,
+        plane=attempt.start.plane,
+        orientation="direction" if options.warp_direction is not None else attempt.rotation,
+        initial_guess=attempt.start.kind,
+        warp_direction=None if options.warp_direction is None else np.array(options.warp_direction),
+        warp_deviation=attempt.deviation,
+        overlap=attempt.overlap,
     )
+
+
+@dataclass
+class _Attempt:
+    """A solve from one start: where it ended and how."""
+
+    start: Start
+    coordinates: np.ndarray
+    problem: Problem
+    fibres: Fibres
+    rotation: str
+    reason: str | None
+    deviation: float | None
+    overlap: Overlap | None
+
+    @property
+    def energy(self) -> float:
+        return self.problem.energy(self.coordinates)
+
+
+@dataclass
+class _Run:
+    """What the attempts of one solve share: the problem's data, the options, and the records
+    of every iteration and step."""
+
+    mesh: SurfaceMesh
+    material: Hyperelastic
+    thickness: float
+    prestress: object
+    options: SolveOptions
+    callback: Callable[[IterationRecord], None] | None
+    history: list[IterationRecord] = field(default_factory=list)
+    steps: list = field(default_factory=list)
+    path: list[str] = field(default_factory=list)
+    solver_name: str = ""
+
+    def problem(self, fibres: Fibres) -> Problem:
+        return Problem(
+            self.mesh, self.material, self.thickness, fibres=fibres, prestress=self.prestress
+        )
+
+    def attempt(self, start: Start, restart: bool = False) -> _Attempt:
+        """Solve from ``start``: the strategy's plan, then the warp alignment, then the check
+        that the pattern is one-to-one."""
+        options = self.options
+        fibres = Fibres.from_angles(options.warp_angle, options.fill_angle)
+        problem = self.problem(fibres)
+        rotation = options.orientation if problem.orientation_matters else "fixed"
+        ctx = self._context(problem, start, rotation)
+        if restart:
+            self.path.append("restart from Tutte's embedding")
+        x, deviation = start.coordinates, None
+        reason = _folded_start(problem, start)
+        if reason is None:
+            direction = options.warp_direction
+            if direction is not None:
+                direction = np.array(direction)
+                fibres = initial_fibres(fibres, options.warp_angle, x, problem, direction)
+                problem = self.problem(fibres)
+            attempts = plan(options.strategy, options.steps, start.plane is not None)
+            x, path, reason = follow_plan(problem, x, start.plane, attempts, ctx, options.damping)
+            self.path += path
+            if reason is None and direction is not None:
+                self.path.append("warp alignment")
+                try:
+                    x, fibres, deviation = align_warp(
+                        self.problem, x, fibres, direction, ctx, options.damping
+                    )
+                    deviation = float(np.degrees(deviation))
+                except Failure as failure:
+                    reason, x = failure.reason, failure.coordinates
+                x, fibres = _warp_along_x(x, fibres, ctx)
+                problem = self.problem(fibres)
+        overlap = None if reason is not None else pattern_overlap(self.mesh, x)
+        if overlap is not None:
+            reason = overlap.describe(self.mesh)
+        return _Attempt(start, x, problem, fibres, rotation, reason, deviation, overlap)
+
+    def _context(self, problem: Problem, start: Start, rotation: str) -> NewtonContext:
+        free, constraint = rigid_modes(start.coordinates, rotation)
+        solver = get_solver(self.options.linear_solver)
+        self.solver_name = solver.name
+        scale = self.material.stiffness_scale * problem.thickness * self.mesh.area
+        return NewtonContext(
+            assembler=Assembler(self.mesh, free),
+            linear_solver=solver,
+            residual_tolerance=self.options.tolerance * problem.force_scale,
+            energy_noise=ENERGY_NOISE * scale,
+            force_scale=problem.force_scale,
+            max_iterations=self.options.max_iterations,
+            history=self.history,
+            steps=self.steps,
+            callback=self.callback,
+            constraint=constraint,
+        )
 
 
 def _folded_start(problem: Problem, start: Start) -> str | None:

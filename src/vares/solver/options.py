@@ -16,7 +16,7 @@ __all__ = ["INITIAL_GUESSES", "ORIENTATIONS", "STRATEGIES", "SolveOptions"]
 
 STRATEGIES = ("auto", "newton", "pseudo-time", "damping")
 ORIENTATIONS = ("held", "free")
-INITIAL_GUESSES = ("auto", "projection", "lscm")
+INITIAL_GUESSES = ("auto", "projection", "lscm", "tutte")
 
 
 @dataclass(frozen=True)
@@ -66,8 +66,9 @@ class SolveOptions(Options):
     initial_guess: str = option(
         "auto",
         "str",
-        "Start: projection onto the plane, the conformal map (lscm), or auto (the projection "
-        "unless no plane is named and it folds or flattens a cell below 0.2 of its area).",
+        "Start: projection onto the plane, the conformal map (lscm), Tutte's embedding (tutte: "
+        "never folds a disk), or auto (the projection unless no plane is named and it flattens "
+        "a cell below 0.2 of its area, then the conformal map; Tutte's wherever these fold).",
         section="solver",
         choices=INITIAL_GUESSES,
     )
@@ -113,9 +114,9 @@ class SolveOptions(Options):
             raise OptionsError(
                 None, "a warp direction fixes the orientation; it cannot also be free"
             )
-        if self.strategy == "pseudo-time" and self.initial_guess == "lscm":
+        if self.strategy == "pseudo-time" and self.initial_guess in ("lscm", "tutte"):
             raise OptionsError(
-                None, "pseudo-time stepping starts from the projection, not from the conformal map"
+                None, "pseudo-time stepping starts from the projection, not from a flattening"
             )
 
     @property

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.flatten import ProjectionPlane, signed_area
+from ..geometry.injectivity import Overlap
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic
 from ..mechanics.fields import cell_fields
@@ -78,6 +79,9 @@ class PatternResult:
     warp_direction, warp_deviation
         The prescribed 3D warp direction (or None) and the final 3D-area-weighted mean angle
         (degrees) between it and the erected warp.
+    overlap
+        Where the pattern overlaps itself (:class:`vares.geometry.injectivity.Overlap`), when
+        it does: such a pattern is not converged (it cannot be cut in one piece).
     """
 
     mesh: SurfaceMesh
@@ -100,6 +104,7 @@ class PatternResult:
     initial_guess: str = "projection"
     warp_direction: np.ndarray | None = None
     warp_deviation: float | None = None
+    overlap: Overlap | None = None
     _fields: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     @property

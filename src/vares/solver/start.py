@@ -1,17 +1,27 @@
 """The initial guess: where Newton's method starts, and which plane the pseudo-time path uses.
 
 The paper's start is the orthogonal projection onto a plane; it is also the exact solution at
-the beginning of the pseudo-time path. Where the surface is steep to the plane, the projection
-distorts or folds cells; the least-squares conformal map (LSCM) is then the better start.
+the beginning of the pseudo-time path. Where the surface is steep to the plane the projection
+distorts or folds cells; the least-squares conformal map (LSCM) is then the better start. Both
+can fold on rough or strongly curved meshes; Tutte's embedding never folds a disk, and the
+automatic choice falls back to it.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.flatten import ProjectionPlane, lscm, projection_distortion, projection_plane
+from ..geometry.flatten import (
+    ProjectionPlane,
+    inverted_cells,
+    lscm,
+    projection_distortion,
+    projection_plane,
+    tutte,
+)
 from ..geometry.mesh import SurfaceMesh
 from ..options import OptionsError
 from .options import SolveOptions
@@ -20,12 +30,13 @@ __all__ = ["PROJECTION_MIN_AREA_RATIO", "Start", "initial_guess"]
 
 #: Below this smallest projected/3D area ratio (about 78° of slope) the projection is no start.
 PROJECTION_MIN_AREA_RATIO = 0.2
+_NAMES = {"projection": "the projection", "lscm": "the conformal map", "tutte": "Tutte's embedding"}
 
 
 @dataclass(frozen=True)
 class Start:
-    """An initial pattern ``(n, 2)``, what it is (``"projection"``, ``"lscm"`` or ``"given"``)
-    and, for a projection, its plane (the pseudo-time path needs it)."""
+    """An initial pattern ``(n, 2)``, what it is (``"projection"``, ``"lscm"``, ``"tutte"`` or
+    ``"given"``) and, for a projection, its plane (the pseudo-time path needs it)."""
 
     coordinates: np.ndarray
     kind: str
@@ -38,29 +49,53 @@ def initial_guess(
     """The start that ``options.initial_guess`` asks for, or the ``given`` coordinates.
 
     ``"auto"`` takes the projection onto ``options.plane``, unless no plane is named and the
-    best-fit projection folds a cell or flattens one below :data:`PROJECTION_MIN_AREA_RATIO` of
-    its area; then the conformal map (not with pseudo-time stepping, whose path needs a plane).
+    best-fit projection flattens a cell below :data:`PROJECTION_MIN_AREA_RATIO` of its area;
+    then the conformal map. Whichever of these folds a cell is passed over (with a warning) for
+    the next, down to Tutte's embedding (not with pseudo-time stepping, whose path needs the
+    projection).
     """
     if given is not None:
-        if options.strategy == "pseudo-time":
-            raise OptionsError(
-                None,
-                "pseudo-time stepping starts from the projection; drop the initial guess or "
-                "choose another strategy",
-            )
-        start = np.array(given, dtype=float)
-        if start.shape != (mesh.num_points, 2) or not np.all(np.isfinite(start)):
-            raise OptionsError(
-                "initial_guess",
-                f"must be finite coordinates of shape ({mesh.num_points}, 2); got {start.shape}",
-            )
-        return Start(start, "given", None)
+        return _given(mesh, options, given)
     plane = projection_plane(mesh, options.plane)
-    kind = options.initial_guess
-    if kind == "auto":
-        steep = projection_distortion(mesh, plane) < PROJECTION_MIN_AREA_RATIO
-        use_lscm = not options.named_plane and options.strategy != "pseudo-time" and steep
-        kind = "lscm" if use_lscm else "projection"
+    if options.initial_guess != "auto":
+        return _make(mesh, options.initial_guess, plane)
+    steep = projection_distortion(mesh, plane) < PROJECTION_MIN_AREA_RATIO
+    order = ["projection", "lscm", "tutte"]
+    if options.strategy == "pseudo-time":
+        order = ["projection"]
+    elif steep and not options.named_plane:
+        order = ["lscm", "tutte"]
+    folded = []
+    for kind in order:
+        start = _make(mesh, kind, plane)
+        inverted = inverted_cells(mesh, start.coordinates)
+        if not inverted.size:
+            if folded:
+                warnings.warn(f"{'; '.join(folded)}: started from {_NAMES[kind]}", stacklevel=3)
+            return start
+        folded.append(f"{_NAMES[kind]} folds {inverted.size} cell(s)")
+    return _make(mesh, order[0], plane)
+
+
+def _make(mesh: SurfaceMesh, kind: str, plane: ProjectionPlane) -> Start:
     if kind == "projection":
         return Start(plane.project(mesh.points), "projection", plane)
-    return Start(lscm(mesh), "lscm", None)
+    if kind == "lscm":
+        return Start(lscm(mesh), "lscm", None)
+    return Start(tutte(mesh), "tutte", None)
+
+
+def _given(mesh: SurfaceMesh, options: SolveOptions, given: np.ndarray) -> Start:
+    if options.strategy == "pseudo-time":
+        raise OptionsError(
+            None,
+            "pseudo-time stepping starts from the projection; drop the initial guess or "
+            "choose another strategy",
+        )
+    start = np.array(given, dtype=float)
+    if start.shape != (mesh.num_points, 2) or not np.all(np.isfinite(start)):
+        raise OptionsError(
+            "initial_guess",
+            f"must be finite coordinates of shape ({mesh.num_points}, 2); got {start.shape}",
+        )
+    return Start(start, "given", None)

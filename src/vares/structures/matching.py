@@ -29,6 +29,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
+from ..geometry.injectivity import pattern_overlap
 from ..materials import Hyperelastic
 from ..mechanics.assembly import Assembler
 from ..mechanics.problem import Problem
@@ -210,17 +211,28 @@ def _match(
         coordinates = [x + alpha * d for x, d in zip(coordinates, deltas, strict=True)]
         multipliers = multipliers + alpha * dlam
     after = [seam_lengths(coordinates, s) for s in out.seams]
-    results = [
-        replace(
+    results = []
+    for panel, result, x, problem in zip(
+        out.panels, out.results, coordinates, coupled.problems, strict=True
+    ):
+        # a matched pattern is checked again: it must still be cuttable in one piece
+        overlap = pattern_overlap(result.mesh, x) if converged else None
+        own_reason = reason if not converged else None
+        if overlap is not None:
+            own_reason = overlap.describe(result.mesh)
+        matched = replace(
             result,
             material_coordinates=x,
             energy=problem.energy(x),
-            converged=converged,
-            reason=None if converged else reason,
+            converged=own_reason is None,
+            reason=own_reason,
+            overlap=overlap,
             _fields=None,
         )
-        for result, x, problem in zip(out.results, coordinates, coupled.problems, strict=True)
-    ]
+        results.append(matched)
+        if overlap is not None and reason is None:
+            reason = f"panel {panel.name}: {own_reason}"
+    converged = reason is None
     return replace(
         out,
         results=results,

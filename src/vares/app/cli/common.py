@@ -13,7 +13,7 @@ from rich.table import Table
 
 from ...analysis.statistics import field_statistics
 from ...geometry.mesh import MeshError
-from ...io.files import OutputExistsError, atomic_path, check_writable
+from ...io.files import OutputExistsError
 from ...materials import MaterialError
 from ...mechanics.fields import KEY_FIELDS
 from ...options import OptionsError
@@ -77,7 +77,13 @@ def progress(quiet: bool) -> Callable[[IterationRecord], None] | None:
 
 
 def field_table(fields: dict[str, np.ndarray]) -> Table:
-    table = Table("field", "min", "mean", "max", title="per-cell results (mean: area-weighted)")
+    table = Table(
+        "field",
+        "min",
+        "mean",
+        "max",
+        title="per-cell results on the design shape (mean: area-weighted)",
+    )
     statistics = field_statistics(fields)
     for name in KEY_FIELDS:
         s = statistics[name]
@@ -90,7 +96,7 @@ def _compensation_table(report) -> Table:
         "",
         "warp",
         "fill",
-        title="compensation and prestress (force per length; means area-weighted)",
+        title="compensation and prestress on the design shape (force/length; area-weighted means)",
     )
     for row in report.rows():
         table.add_row(*row)
@@ -164,20 +170,16 @@ def show(outcome: JobOutcome) -> None:
 
 def execute(job: Job, *, force: bool, quiet: bool, save_job: Path | None = None) -> None:
     """Run a job from the command line: progress, summary, ``--save-job``, exit status."""
-    if save_job is not None:
-        if save_job.suffix.lower() != ".toml":
-            raise InputError(f"--save-job: a job file ends in .toml; got {save_job}")
-        check_writable([save_job], force)
+    if save_job is not None and save_job.suffix.lower() != ".toml":
+        raise InputError(f"--save-job: a job file ends in .toml; got {save_job}")
 
     def starting(name, mesh, material) -> None:
         if not quiet:
             console.print(f"{name}: {mesh}; {material!r}, thickness {job.material.thickness:g}")
 
-    outcome = run_job(job, force=force, callback=progress(quiet), on_solve_start=starting)
-    if save_job is not None:
-        with atomic_path(save_job) as temporary:
-            temporary.write_text(job.to_toml(save_job), encoding="utf-8")
-        outcome.files.append(save_job)
+    outcome = run_job(
+        job, force=force, callback=progress(quiet), on_solve_start=starting, save_job=save_job
+    )
     if not quiet:
         show(outcome)
     if not outcome.converged:

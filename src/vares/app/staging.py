@@ -1,0 +1,152 @@
+"""An output folder that holds one whole run: written beside it, then put in place at once.
+
+A run writes its files into a hidden staging folder next to the output folder. When every file
+is written, the staging folder takes the output folder's place (the previous run, if any, is
+moved aside first and then deleted), so an output folder holds one whole run or the previous
+one — never a mix, also when a run is interrupted. A manifest (``.vares-run.json``) lists the
+files of the run, so the next run knows which files it may replace.
+
+Before any work :meth:`OutputFolder.check` refuses what would lose something: an output path
+that is a file, a folder holding files vares did not write (they would be lost), an existing
+run without ``force``, an input among the files to be written, a folder that cannot be written.
+An input that a previous run wrote into the folder (a job file saved there) is carried over.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+from .._version import __version__
+from ..io.files import OutputExistsError
+
+__all__ = ["MANIFEST", "OutputFolder"]
+
+#: The file in an output folder that lists what the run wrote.
+MANIFEST = ".vares-run.json"
+
+
+class OutputFolder:
+    """The output folder ``directory`` of a run that will write ``planned`` (paths inside it)
+    and reads ``inputs``; see the module docs."""
+
+    def __init__(
+        self, directory: Path, planned: Iterable[Path], *, force: bool, inputs: Iterable[Path]
+    ) -> None:
+        self.directory = Path(directory).resolve()
+        self.planned = [Path(p).resolve() for p in planned]
+        self.force = force
+        self.inputs = {Path(p).resolve() for p in inputs}
+        self.staging: Path | None = None
+
+    # ------------------------------------------------------------------ before the work
+    def check(self) -> None:
+        """Refuse (with a one-line error) anything that would lose a file or fail late."""
+        for path in self.planned:
+            if path in self.inputs:
+                raise OutputExistsError(
+                    f"the output {path} is an input of the run: choose another output folder"
+                )
+        if self.directory.exists() and not self.directory.is_dir():
+            raise OutputExistsError(f"the output folder {self.directory} is a file")
+        existing = self._existing()
+        ours = self._previous() | {p.relative_to(self.directory) for p in self.planned}
+        foreign = sorted(str(p) for p in existing - ours)
+        if foreign:
+            shown = ", ".join(foreign[:4]) + (", …" if len(foreign) > 4 else "")
+            raise OutputExistsError(
+                f"the output folder {self.directory} holds files vares did not write ({shown}); "
+                "they would be lost: choose a new or empty folder"
+            )
+        if existing and not self.force:
+            shown = ", ".join(str(self.directory / p) for p in sorted(existing)[:3])
+            raise OutputExistsError(
+                f"output exists: {shown}{', …' if len(existing) > 3 else ''} (use --force to "
+                "replace the previous run)"
+            )
+        self._writable()
+
+    def _existing(self) -> set[Path]:
+        if not self.directory.is_dir():
+            return set()
+        return {
+            p.relative_to(self.directory)
+            for p in self.directory.rglob("*")
+            if p.is_file() and p.name != MANIFEST
+        }
+
+    def _previous(self) -> set[Path]:
+        try:
+            data = json.loads((self.directory / MANIFEST).read_text(encoding="utf-8"))
+            return {Path(p) for p in data["files"]}
+        except (OSError, ValueError, KeyError, TypeError):
+            return set()
+
+    def _writable(self) -> None:
+        parent = self.directory.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            probe = tempfile.mkdtemp(prefix=f".{self.directory.name}.probe-", dir=parent)
+            os.rmdir(probe)
+        except OSError as exc:
+            raise OSError(
+                exc.errno, f"cannot write into {parent}: {exc.strerror}", str(parent)
+            ) from None
+
+    # ------------------------------------------------------------------ the work
+    def start(self) -> Path:
+        """Create the staging folder; the run writes into it."""
+        self.staging = Path(
+            tempfile.mkdtemp(prefix=f".{self.directory.name}.vares-", dir=self.directory.parent)
+        )
+        planned = set(self.planned)
+        for path in self.inputs:  # inputs a previous run wrote here stay with the new run
+            if self.directory in path.parents and path not in planned:
+                target = self.staged(path)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(path, target)
+        return self.staging
+
+    def staged(self, path: Path) -> Path:
+        """Where ``path`` (inside the output folder) is written during the run."""
+        return self.staging / Path(path).resolve().relative_to(self.directory)
+
+    def final(self, path: Path) -> Path:
+        """Where a staged file ends up."""
+        return self.directory / Path(path).relative_to(self.staging)
+
+    def commit(self) -> None:
+        """Put the staged run in place of the output folder (module docs)."""
+        files = sorted(
+            str(p.relative_to(self.staging)) for p in self.staging.rglob("*") if p.is_file()
+        )
+        manifest = {"vares_version": __version__, "files": files}
+        text = json.dumps(manifest, indent=2) + "\n"
+        (self.staging / MANIFEST).write_text(text, encoding="utf-8")
+        os.chmod(self.staging, 0o777 & ~_umask())
+        previous = None
+        if self.directory.exists():
+            previous = Path(
+                tempfile.mkdtemp(prefix=f".{self.directory.name}.old-", dir=self.directory.parent)
+            )
+            os.replace(self.directory, previous / "run")
+        os.replace(self.staging, self.directory)
+        self.staging = None
+        if previous is not None:
+            shutil.rmtree(previous, ignore_errors=True)
+
+    def discard(self) -> None:
+        """Remove the staging folder of a run that did not finish."""
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging = None
+
+
+def _umask() -> int:
+    current = os.umask(0)
+    os.umask(current)
+    return current

@@ -1,0 +1,120 @@
+"""Readers for the polygon formats that meshio reads too narrowly: Wavefront OBJ (faces with
+texture and normal indices ``f 1/1/1 …``, negative indices, polygons) and OFF (quads and
+polygons, ``COFF``/``NOFF`` variants, per-face colours ignored).
+
+Each returns a :class:`PolygonSoup`: points, triangle and quad blocks and the longer polygons,
+in the order the faces appear in the file block by block (triangles, quads, polygons).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry.mesh import MeshError
+
+__all__ = ["PolygonSoup", "read_obj", "read_off"]
+
+
+@dataclass
+class PolygonSoup:
+    """Points ``(n, 3)``, faces by size, and the per-face order of the file: face ``k`` of the
+    file is ``order[k]`` in the block-by-block numbering (triangles, quads, polygons)."""
+
+    points: np.ndarray
+    cells: dict[str, np.ndarray] = field(default_factory=dict)
+    polygons: list[np.ndarray] = field(default_factory=list)
+
+
+def _soup(points: list[list[float]], faces: list[list[int]], path: Path) -> PolygonSoup:
+    if not points:
+        raise MeshError(f"{path} contains no vertices")
+    coordinates = np.array(points, dtype=float)
+    n = len(coordinates)
+    triangles, quads, polygons = [], [], []
+    for number, face in enumerate(faces, start=1):
+        if len(face) < 3:
+            continue  # a point or a line, not a surface cell
+        bad = [i for i in face if not -n <= i < n]
+        if bad:
+            raise MeshError(
+                f"{path}: face {number} refers to vertex {bad[0] + 1 if bad[0] >= 0 else bad[0]} "
+                f"but the file has {n} vertices"
+            )
+        face = [i % n for i in face]
+        (triangles if len(face) == 3 else quads if len(face) == 4 else polygons).append(face)
+    if not (triangles or quads or polygons):
+        raise MeshError(f"{path} contains no triangle or quad cells")
+    cells = {}
+    if triangles:
+        cells["triangle"] = np.array(triangles, dtype=np.int64)
+    if quads:
+        cells["quad"] = np.array(quads, dtype=np.int64)
+    return PolygonSoup(coordinates, cells, [np.array(p, dtype=np.int64) for p in polygons])
+
+
+def _numbers(tokens: list[str], path: Path, line: int, kind=float) -> list:
+    try:
+        return [kind(t) for t in tokens]
+    except ValueError:
+        raise MeshError(f"{path}, line {line}: cannot read {' '.join(tokens)!r}") from None
+
+
+def read_obj(path: Path) -> PolygonSoup:
+    """Vertices (``v x y z [w]``) and faces (``f a b c …`` with ``a``, ``a/t``, ``a//n`` or
+    ``a/t/n``; 1-based, negative = relative to the end) of a Wavefront OBJ file."""
+    points: list[list[float]] = []
+    faces: list[list[int]] = []
+    text = _text(path)
+    for number, line in enumerate(text.splitlines(), start=1):
+        tokens = line.split()
+        if not tokens:
+            continue
+        if tokens[0] == "v":
+            values = _numbers(tokens[1:4], path, number)
+            if len(values) != 3:
+                raise MeshError(f"{path}, line {number}: a vertex needs x, y and z")
+            points.append(values)
+        elif tokens[0] == "f":
+            indices = _numbers([t.split("/")[0] for t in tokens[1:]], path, number, int)
+            # 1-based; negative counts back from the vertices read so far
+            faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
+    return _soup(points, faces, path)
+
+
+def read_off(path: Path) -> PolygonSoup:
+    """An OFF file: header (``OFF``, ``COFF``, ``NOFF`` …), counts, vertices, faces
+    ``k i1 … ik [colour]``."""
+    lines = [
+        (number, line.split("#")[0].split())
+        for number, line in enumerate(_text(path).splitlines(), start=1)
+    ]
+    lines = [(number, tokens) for number, tokens in lines if tokens]
+    if not lines or not lines[0][1][0].endswith("OFF"):
+        raise MeshError(f"{path} is not an OFF file (no OFF header)")
+    header = lines[0][1][1:] or lines[1][1]
+    body = lines[1:] if lines[0][1][1:] else lines[2:]
+    counts = _numbers(header[:2], path, lines[0][0], int)
+    if len(counts) != 2:
+        raise MeshError(f"{path}: the OFF header needs the vertex and face counts")
+    n_points, n_faces = counts
+    if len(body) < n_points + n_faces:
+        raise MeshError(
+            f"{path} is truncated: it announces {n_points} vertices and {n_faces} faces but "
+            f"holds {len(body)} lines of them"
+        )
+    points = [_numbers(tokens[:3], path, number) for number, tokens in body[:n_points]]
+    faces = []
+    for number, tokens in body[n_points : n_points + n_faces]:
+        size = _numbers(tokens[:1], path, number, int)[0]
+        faces.append(_numbers(tokens[1 : 1 + size], path, number, int))
+    return _soup(points, faces, path)
+
+
+def _text(path: Path) -> str:
+    data = Path(path).read_bytes()
+    if b"\x00" in data[:4096]:
+        raise MeshError(f"cannot read {path}: it is a binary file, not text")
+    return data.decode("utf-8", errors="replace")

@@ -1,0 +1,170 @@
+"""Real inputs: readers for ordinary files, repair said aloud, units, coarse precision."""
+
+import json
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import vares
+from vares.app.cli import app
+from vares.geometry.examples import hypar
+from vares.geometry.repair import repair
+from vares.io.meshes import read_mesh_file
+from vares.io.rhino import NamedMesh, write_3dm
+
+runner = CliRunner()
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def error_line(result):
+    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
+def _obj_with_texture(path, mesh):
+    """An OBJ as modellers write it: texture and normal indices, negative indices for the last
+    face, a comment and a group."""
+    lines = ["# exported", "o roof", "g canopy"]
+    lines += [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in mesh.points]
+    lines += [f"vt {u:.3f} {v:.3f}" for u, v in mesh.points[:, :2] / 10]
+    lines += ["vn 0 0 1"]
+    triangles = mesh.cells["triangle"] + 1
+    for a, b, c in triangles[:-1]:
+        lines.append(f"f {a}/{a}/1 {b}/{b}/1 {c}/{c}/1")
+    n = mesh.num_points
+    a, b, c = triangles[-1] - n - 1  # relative indices
+    lines.append(f"f {a}//1 {b}//1 {c}//1")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_obj_with_texture_normal_and_relative_indices(tmp_path):
+    mesh = hypar(n=6)
+    path = tmp_path / "roof.obj"
+    _obj_with_texture(path, mesh)
+    read = vares.read_mesh(path)
+    np.testing.assert_array_equal(read.points, mesh.points)
+    np.testing.assert_array_equal(read.cells["triangle"], mesh.cells["triangle"])
+
+
+def test_off_and_ply_with_quads_and_polygons(tmp_path):
+    # a 3 × 2 grid of quads and a pentagon closing one side
+    x, y = np.meshgrid(np.arange(4.0), np.arange(3.0))
+    points = np.column_stack([x.ravel(), y.ravel(), 0.05 * x.ravel() ** 2])
+    quads = [
+        [j * 4 + i, j * 4 + i + 1, (j + 1) * 4 + i + 1, (j + 1) * 4 + i]
+        for j in range(2)
+        for i in range(3)
+    ]
+    points = np.vstack([points, [[4.0, 0.0, 0.8], [4.5, 1.0, 1.0], [4.0, 2.0, 0.8]]])
+    pentagon = [3, 12, 13, 14, 11, 7]  # a hexagon, to be triangulated
+    off = tmp_path / "panel.off"
+    off.write_text(
+        "OFF\n# a comment\n"
+        + f"{len(points)} {len(quads) + 1} 0\n"
+        + "".join(f"{p[0]} {p[1]} {p[2]}\n" for p in points)
+        + "".join(f"4 {' '.join(map(str, q))} 255 0 0\n" for q in quads)
+        + f"6 {' '.join(map(str, pentagon))}\n"
+    )
+    mesh_file = read_mesh_file(off)
+    assert mesh_file.repair.triangulated_polygons == 1
+    surface = mesh_file.surface()
+    assert len(surface.cells["quad"]) == 6 and len(surface.cells["triangle"]) == 4
+    # the triangles cover the polygon: their vector areas add up to the polygon's (which any
+    # triangulation of a closed polygon, planar or not, must give)
+    polygon = points[pentagon]
+    vector_area = 0.5 * np.cross(polygon, np.roll(polygon, -1, axis=0)).sum(axis=0)
+    triangles = surface.points[surface.cells["triangle"]]
+    covered = 0.5 * np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    np.testing.assert_allclose(covered.sum(axis=0), vector_area, atol=1e-12)
+    assert set(surface.cells["triangle"].ravel()) == set(pentagon)
+    ply = tmp_path / "panel.ply"
+    meshio.write(ply, meshio.Mesh(points[:12], [("quad", np.array(quads))]), binary=False)
+    assert len(vares.read_mesh(ply).cells["quad"]) == 6
+
+
+def test_a_triangle_soup_is_welded_and_reoriented_and_said_so(tmp_path):
+    mesh = hypar(n=5)
+    triangles = mesh.cells["triangle"]
+    soup_points = mesh.points[triangles.ravel()]  # every triangle its own three nodes
+    soup = np.arange(soup_points.shape[0]).reshape(-1, 3)
+    soup[::3] = soup[::3, ::-1]  # a third of the cells the other way round
+    path = tmp_path / "soup.stl"
+    meshio.write(path, meshio.Mesh(soup_points, [("triangle", soup)]), binary=False)
+    raw = tmp_path / "soup.obj"
+    raw.write_text(
+        "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in soup_points)
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in soup)
+    )
+    mesh_file = read_mesh_file(raw)
+    report = mesh_file.repair
+    assert report.welded_nodes == soup_points.shape[0] - mesh.num_points
+    assert report.flipped_cells == len(soup[::3])
+    surface = mesh_file.surface()
+    assert surface.num_points == mesh.num_points and surface.area == pytest.approx(mesh.area)
+    with pytest.warns(UserWarning, match=r"repaired soup.obj: welded 114 node"):
+        vares.read_mesh(raw)
+    result = run("pattern", raw, "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["repairs"]["soup.obj"]["welded_nodes"] == 114
+    assert any("repaired soup.obj" in w for w in summary["warnings"])
+    result = run("pattern", raw, "-o", tmp_path / "strict", "--no-repair", "-q")
+    assert result.exit_code == 2 and "separate pieces" in error_line(result)
+
+
+def test_repair_drops_collapsed_and_duplicate_cells_and_keeps_cell_data_aligned():
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [1e-12, 0, 0]], float)
+    cells = {"triangle": np.array([[0, 1, 2], [0, 2, 3], [2, 0, 1], [4, 1, 0]])}
+    fixed = repair(points, cells)
+    assert fixed.report.welded_nodes == 1 and fixed.report.collapsed_cells == 1
+    assert fixed.report.duplicate_cells == 1
+    np.testing.assert_array_equal(fixed.cell_map, [0, 1])
+    assert len(fixed.points) == 4
+
+
+def test_units_declared_by_a_rhino_file_and_implausible_sizes(tmp_path):
+    roof = hypar(size=27600.0, rise=0.06 / 1000, n=6)  # a 27.6 m roof modelled in millimetres
+    path = tmp_path / "roof.3dm"
+    write_3dm(path, [NamedMesh("roof", "membrane", roof)], units="mm")
+    result = run("pattern", path, "-o", tmp_path / "out", "-q", "--allowance", 20)
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["units"]["length"] == "mm"
+    assert not any("implausible" in w for w in summary["warnings"])
+    result = run("pattern", path, "-o", tmp_path / "m", "--units", "m", "-q")
+    assert result.exit_code == 2 and "declares its coordinates in mm" in error_line(result)
+    # the same roof as a unitless file, run without --units
+    obj = tmp_path / "roof.obj"
+    obj.write_text(
+        "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in roof.points)
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in roof.cells["triangle"])
+    )
+    result = run("pattern", obj, "-o", tmp_path / "guess")
+    assert result.exit_code == 0, result.stderr
+    assert "the surface is 27.6 km across in m" in result.stderr
+    assert "pass --units mm" in result.stderr
+    summary = json.loads((tmp_path / "guess" / "summary.json").read_text())
+    assert any("27.6 km" in w for w in summary["warnings"])
+
+
+def test_single_precision_far_from_the_origin_is_warned_of(tmp_path):
+    roof = hypar(size=10.0, n=8)
+    site = roof.points + np.array([4.3e6, 5.2e5, 300.0])  # UTM-like site coordinates
+    path = tmp_path / "site.stl"
+    cells = [("triangle", roof.cells["triangle"])]
+    meshio.write(path, meshio.Mesh(site.astype(np.float32), cells), binary=True)
+    mesh_file = read_mesh_file(path)
+    assert mesh_file.resolution == pytest.approx(0.5)
+    warning = mesh_file.precision_warning()
+    assert "single precision" in warning and "only known to 0.5" in warning
+    near = tmp_path / "near.stl"
+    meshio.write(
+        near, meshio.Mesh(roof.points.astype(np.float32), [("triangle", roof.cells["triangle"])])
+    )
+    assert read_mesh_file(near).precision_warning() is None

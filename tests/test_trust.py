@@ -1,0 +1,157 @@
+"""No folded start, no folded pattern called converged, nothing lost and nothing mixed."""
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import vares
+from vares.app.cli import app
+from vares.geometry.examples import hypar, ruffled_fan
+from vares.geometry.flatten import inverted_cells, lscm, tutte
+from vares.geometry.injectivity import pattern_overlap
+from vares.io.meshes import write_surface
+
+runner = CliRunner()
+NEO_HOOKE = vares.materials.NeoHooke(1000.0, 0.3)
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def error_line(result):
+    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
+def test_tutte_is_one_to_one_where_the_conformal_map_folds():
+    mesh = hypar(size=2.0, rise=2.5, n=20)  # the steep saddle z = 2.5 x y
+    assert inverted_cells(mesh, lscm(mesh)).size == 2
+    start = tutte(mesh)
+    assert inverted_cells(mesh, start).size == 0 and pattern_overlap(mesh, start) is None
+    assert vares.geometry.signed_area(mesh, start) == pytest.approx(mesh.area)
+    with pytest.warns(UserWarning, match="the conformal map folds 2 cell.*Tutte's embedding"):
+        result = vares.solve(mesh, NEO_HOOKE)
+    assert result.converged and result.initial_guess == "tutte"
+
+
+def test_tutte_on_a_surface_with_a_hole():
+    x, y = np.meshgrid(np.linspace(-1, 1, 9), np.linspace(-1, 1, 9))
+    points = np.column_stack([x.ravel(), y.ravel(), 0.3 * x.ravel() * y.ravel()])
+    quads = [
+        [j * 9 + i, j * 9 + i + 1, (j + 1) * 9 + i + 1, (j + 1) * 9 + i]
+        for j in range(8)
+        for i in range(8)
+        if not (3 <= i <= 4 and 3 <= j <= 4)  # a 2 × 2 hole in the middle
+    ]
+    mesh = vares.SurfaceMesh(points, {"quad": np.array(quads)}, drop_unused_nodes=True)
+    assert len(mesh.boundary_loops()) == 2
+    start = tutte(mesh)
+    assert inverted_cells(mesh, start).size == 0 and pattern_overlap(mesh, start) is None
+    result = vares.solve(mesh, NEO_HOOKE, initial_guess="tutte")
+    assert result.converged and result.initial_guess == "tutte"
+
+
+def test_a_minimum_that_laps_over_itself_is_left_for_one_from_tutte():
+    mesh = hypar(size=2.0, rise=2.5, n=10)
+    from_lscm = vares.solve(mesh, NEO_HOOKE, initial_guess="lscm")
+    assert not from_lscm.converged and from_lscm.overlap is not None
+    assert "outline crosses itself" in from_lscm.reason
+    result = vares.solve(mesh, NEO_HOOKE)
+    assert result.converged and result.initial_guess == "tutte"
+    assert "restart from Tutte's embedding" in result.strategy
+    assert result.energy < 0.5 * from_lscm.energy
+
+
+def test_a_pattern_that_overlaps_itself_is_not_converged_nor_cut(tmp_path):
+    mesh = ruffled_fan()  # developable, but 1.6 turns of surface around its apex
+    result = vares.solve(mesh, NEO_HOOKE)
+    assert not result.converged and result.overlap is not None
+    assert abs(result.energy) < 1e-9  # the energy is minimal: the pattern is the development
+    assert len(result.overlap.crossings) > 0 and result.overlap.inverted.size == 0
+    source = tmp_path / "fan.obj"
+    write_surface(source, mesh)
+    out = tmp_path / "out"
+    cli = run("pattern", source, "-o", out, "-q")
+    assert cli.exit_code == 1
+    assert "the pattern overlaps itself: its outline crosses itself" in error_line(cli)
+    assert "cut it there (split it into panels) or add a dart" in error_line(cli)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is False and "overlaps itself" in summary["reason"]
+    assert (out / "pattern.svg").exists() and not (out / "pattern.dxf").exists()
+    cli = run("pattern", source, "-o", out, "-q", "--force", "--allow-overlap")
+    assert cli.exit_code == 1 and (out / "pattern.dxf").exists()
+
+
+def test_an_initial_pattern_file_from_the_command_line_and_a_job(tmp_path):
+    mesh = hypar(n=8)
+    source = tmp_path / "roof.obj"
+    write_surface(source, mesh)
+    assert run("pattern", source, "-o", tmp_path / "first", "-q").exit_code == 0
+    again = run(
+        "pattern",
+        source,
+        "-o",
+        tmp_path / "again",
+        "--initial-pattern",
+        tmp_path / "first" / "pattern.obj",
+        "-q",
+        "--save-job",
+        tmp_path / "again.toml",
+    )
+    assert again.exit_code == 0, again.stderr
+    summary = json.loads((tmp_path / "again" / "summary.json").read_text())
+    assert summary["iterations"] <= 1  # it starts at the optimum
+    assert 'initial_pattern = "first/pattern.obj"' in (tmp_path / "again.toml").read_text()
+    other = hypar(n=6)
+    write_surface(tmp_path / "other.obj", other)
+    bad = run(
+        "pattern", source, "-o", tmp_path / "bad", "--initial-pattern", tmp_path / "other.obj"
+    )
+    assert bad.exit_code == 2 and "does not have the nodes and faces" in error_line(bad)
+
+
+def test_an_interrupted_forced_rerun_leaves_the_previous_run_whole(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    from vares.app import outputs
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(outputs, "write_dxf", interrupted)
+    result = run("example", "hypar", "-o", out, "-q", "--force", "--E", "2000")
+    assert result.exit_code == 130 and "interrupted" in error_line(result)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging left behind
+
+
+def test_nothing_in_an_output_folder_is_lost(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    mesh = hypar(n=6)
+    write_surface(out / "roof.obj", mesh)  # the input lies in the output folder
+    result = run("pattern", out / "roof.obj", "-o", out, "-q", "--force")
+    assert result.exit_code == 2
+    assert "holds files vares did not write (roof.obj)" in error_line(result)
+    assert sorted(p.name for p in out.iterdir()) == ["roof.obj"]
+    (tmp_path / "file").write_text("not a folder")
+    result = run("pattern", out / "roof.obj", "-o", tmp_path / "file", "-q")
+    assert result.exit_code == 2 and "is a file" in error_line(result)
+    result = run("pattern", out / "roof.obj", "-o", tmp_path / "x", "--save-job", out / "roof.obj")
+    assert result.exit_code == 2 and "ends in .toml" in error_line(result)
+    # a job saved into its output folder goes with the run, and the run can be repeated
+    job = tmp_path / "run" / "job.toml"
+    result = run("pattern", out / "roof.obj", "-o", tmp_path / "run", "--save-job", job, "-q")
+    assert result.exit_code == 0, result.stderr
+    manifest = json.loads((tmp_path / "run" / ".vares-run.json").read_text())
+    assert "job.toml" in manifest["files"] and "pattern.dxf" in manifest["files"]
+    result = run("run", job, "-q")
+    assert result.exit_code == 2 and "use --force to replace the previous run" in error_line(result)
+    result = run("run", job, "-q", "--force")
+    assert result.exit_code == 0, result.stderr
+    assert job.exists() and (tmp_path / "run" / "pattern.dxf").exists()
