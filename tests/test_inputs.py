@@ -168,3 +168,22 @@ def test_single_precision_far_from_the_origin_is_warned_of(tmp_path):
         near, meshio.Mesh(roof.points.astype(np.float32), [("triangle", roof.cells["triangle"])])
     )
     assert read_mesh_file(near).precision_warning() is None
+
+
+def test_a_bow_tie_node_is_split_by_the_repair(tmp_path):
+    # two squares of two triangles each that touch at one node
+    points = np.array(
+        [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 1, 0.1], [2, 2, 0.1], [1, 2, 0.1]], float
+    )
+    triangles = np.array([[0, 1, 2], [0, 2, 3], [2, 4, 5], [2, 5, 6]])
+    path = tmp_path / "bowtie.obj"
+    path.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in points)
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles)
+    )
+    with pytest.raises(vares.MeshError, match="2 separate pieces"):
+        read_mesh_file(path, repair=False).surface()
+    mesh_file = read_mesh_file(path)
+    assert mesh_file.repair.split_nodes == 1 and len(mesh_file.points) == 8
+    pieces = mesh_file.pieces()  # now two pieces, each a surface
+    assert [p.num_cells for p, _ in pieces] == [2, 2]

@@ -87,7 +87,7 @@ def test_bow_tie_node_is_non_manifold():
 def test_closed_surface_is_rejected_with_advice():
     points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
     tetrahedron = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]]
-    with pytest.raises(MeshError, match=r"closed.*cut it open"):
+    with pytest.raises(MeshError, match=r"closed.*give it panels.*vares panels"):
         SurfaceMesh(points, {"triangle": tetrahedron})
 
 

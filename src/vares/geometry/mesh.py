@@ -18,7 +18,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .elements import ELEMENTS
 
-__all__ = ["MeshError", "SurfaceMesh", "connected_pieces"]
+__all__ = ["MeshError", "SurfaceMesh", "connected_pieces", "corner_fans"]
 
 
 class MeshError(ValueError):
@@ -277,7 +277,9 @@ class SurfaceMesh:
         if not (counts == 1).any():
             raise MeshError(
                 "the surface is closed (it has no boundary edge): a closed surface has no "
-                "cutting pattern; cut it open along a seam line first"
+                "cutting pattern in one piece; give it panels (a cell data array with a panel "
+                "id per cell, or one object per panel in a .3dm) and pattern them with "
+                "'vares panels'"
             )
 
         num_cells = self.num_cells
@@ -300,32 +302,7 @@ class SurfaceMesh:
         self, directed: np.ndarray, owner: np.ndarray, edge_id: np.ndarray
     ) -> None:
         """Around each node the cells must form a single fan (no 'bow-tie' nodes)."""
-        # Corners are (cell, node) pairs; two corners at the same node are linked when their
-        # cells share an edge that contains that node.
-        corner_cell = owner
-        corner_node = directed[:, 0]  # each directed edge starts at exactly one corner
-        num_corners = corner_cell.size
-        corner_key = corner_cell * self.num_points + corner_node
-        order = np.argsort(corner_key)
-        sorted_key = corner_key[order]
-
-        def corner_of(cell: np.ndarray, node: np.ndarray) -> np.ndarray:
-            return order[np.searchsorted(sorted_key, cell * self.num_points + node)]
-
-        srt = np.argsort(edge_id, kind="stable")
-        ids = edge_id[srt]
-        pair = np.flatnonzero(ids[1:] == ids[:-1])
-        a, b = srt[pair], srt[pair + 1]
-        rows, cols = [], []
-        for k in (0, 1):
-            node = directed[a, k]
-            rows.append(corner_of(owner[a], node))
-            cols.append(corner_of(owner[b], node))
-        graph = sp.coo_matrix(
-            (np.ones(2 * a.size), (np.concatenate(rows), np.concatenate(cols))),
-            shape=(num_corners, num_corners),
-        )
-        _, fan = connected_components(graph, directed=False)
+        corner_node, fan = corner_fans(self.num_points, directed, owner, edge_id)
         fans_per_node = np.bincount(
             np.unique(np.column_stack([corner_node, fan]), axis=0)[:, 0],
             minlength=self.num_points,
@@ -334,9 +311,40 @@ class SurfaceMesh:
         if bow_tie.size:
             raise MeshError(
                 f"non-manifold nodes {_listing(self._node_map[bow_tie])}: the cells around "
-                "each of them form "
-                "separate fans that touch only at the node"
+                "each of them form separate fans that touch only at the node (reading the file "
+                "with repair on splits such nodes)"
             )
+
+
+def corner_fans(
+    num_points: int, directed: np.ndarray, owner: np.ndarray, edge_id: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The fan of every cell corner: corners (one per directed edge, at its start node) of the
+    same node are in one fan when their cells are joined around the node by shared edges.
+    Returns the node and the fan label of every corner."""
+    corner_node = directed[:, 0]
+    corner_key = owner * num_points + corner_node
+    order = np.argsort(corner_key)
+    sorted_key = corner_key[order]
+
+    def corner_of(cell: np.ndarray, node: np.ndarray) -> np.ndarray:
+        return order[np.searchsorted(sorted_key, cell * num_points + node)]
+
+    srt = np.argsort(edge_id, kind="stable")
+    ids = edge_id[srt]
+    pair = np.flatnonzero(ids[1:] == ids[:-1])
+    a, b = srt[pair], srt[pair + 1]
+    rows, cols = [], []
+    for k in (0, 1):
+        node = directed[a, k]
+        rows.append(corner_of(owner[a], node))
+        cols.append(corner_of(owner[b], node))
+    graph = sp.coo_matrix(
+        (np.ones(2 * a.size), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(corner_node.size, corner_node.size),
+    )
+    _, fan = connected_components(graph, directed=False)
+    return corner_node, fan
 
 
 def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.ndarray:

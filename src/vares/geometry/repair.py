@@ -10,6 +10,7 @@
   boundary are dropped (a zero-area cell inside the surface would leave a slit: it is refused by
   the validation instead, naming the cell);
 - cells are oriented consistently with the majority of their neighbours;
+- a node where separate fans of cells touch (a "bow-tie") is split, one node per fan;
 - nodes that belong to no cell are dropped.
 
 What is not clear — non-manifold edges or nodes, several pieces, a closed surface — is left to
@@ -26,7 +27,7 @@ from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 from scipy.spatial import cKDTree
 
-from .mesh import MeshError, _listing
+from .mesh import MeshError, _listing, corner_fans
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
 
@@ -46,6 +47,7 @@ class RepairReport:
     duplicate_cells: int = 0
     flat_boundary_cells: int = 0
     flipped_cells: int = 0
+    split_nodes: int = 0
     unused_nodes: int = 0
     weld_tolerance: float = 0.0
 
@@ -71,6 +73,8 @@ class RepairReport:
             out.append(f"dropped {self.flat_boundary_cells} zero-area cell(s) on the boundary")
         if self.flipped_cells:
             out.append(f"reoriented {self.flipped_cells} cell(s) to match their neighbours")
+        if self.split_nodes:
+            out.append(f"split {self.split_nodes} node(s) where separate fans of cells touched")
         if self.unused_nodes:
             out.append(f"dropped {self.unused_nodes} node(s) that belong to no cell")
         return out
@@ -138,6 +142,7 @@ def repair(
             blocks, owners, lambda b: _flat_on_boundary(points, b)
         )
         blocks, counts["flipped_cells"] = _orient(blocks)
+        points, blocks, counts["split_nodes"] = _split_bow_ties(points, blocks)
     used = np.zeros(len(points), dtype=bool)
     for block in blocks.values():
         used[block.ravel()] = True
@@ -267,6 +272,41 @@ def _orient(blocks: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], int]:
         out[cell_type] = block
         start += len(block)
     return out, int(flip.sum())
+
+
+def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
+    """A new node for every fan of cells at a node beyond its first (module docs)."""
+    names = list(blocks)
+    directed, owner, block_of, row_of, col_of = [], [], [], [], []
+    offset = 0
+    for index, block in enumerate(blocks.values()):
+        nen = block.shape[1]
+        for i in range(nen):
+            directed.append(np.column_stack([block[:, i], block[:, (i + 1) % nen]]))
+            owner.append(offset + np.arange(len(block)))
+            block_of.append(np.full(len(block), index))
+            row_of.append(np.arange(len(block)))
+            col_of.append(np.full(len(block), i))
+        offset += len(block)
+    if not offset:
+        return points, blocks, 0
+    directed, owner = np.vstack(directed), np.concatenate(owner)
+    _, edge_id = np.unique(np.sort(directed, axis=1), axis=0, return_inverse=True)
+    node, fan = corner_fans(len(points), directed, owner, edge_id.ravel())
+    pairs, label = np.unique(np.column_stack([node, fan]), axis=0, return_inverse=True)
+    extra = np.r_[False, pairs[1:, 0] == pairs[:-1, 0]]  # a node's second fan onward
+    if not extra.any():
+        return points, blocks, 0
+    new_node = np.full(len(pairs), -1)
+    new_node[extra] = len(points) + np.arange(extra.sum())
+    moved = new_node[label.ravel()] >= 0
+    block_of, row_of, col_of = (np.concatenate(a)[moved] for a in (block_of, row_of, col_of))
+    out = {name: block.copy() for name, block in blocks.items()}
+    targets = new_node[label.ravel()[moved]]
+    for index, name in enumerate(names):
+        mine = block_of == index
+        out[name][row_of[mine], col_of[mine]] = targets[mine]
+    return np.vstack([points, points[pairs[extra, 0]]]), out, int(extra.sum())
 
 
 @njit(cache=True)
