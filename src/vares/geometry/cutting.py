@@ -30,7 +30,7 @@ __all__ = ["CutMesh", "cut_mesh"]
 
 #: Crossings closer than this fraction of the edge length to a node are moved onto the node, and
 #: so is a line that passes a cell's corner closer than this fraction of the cell's edges.
-SNAP = 0.15
+SNAP = 0.05
 
 
 @dataclass(frozen=True)
@@ -143,7 +143,9 @@ def cut_mesh(
 def _chain(line: SurfaceLine, nodes: _Nodes, snap: float) -> list[int]:
     """The nodes of a line in the cut mesh, crossings near a node moved onto it."""
     points = nodes.points
-    where = [(int(a), int(b), float(t)) for (a, b), t in zip(line.ends, line.fractions, strict=True)]
+    where = [
+        (int(a), int(b), float(t)) for (a, b), t in zip(line.ends, line.fractions, strict=True)
+    ]
     for k in range(len(where) - 1):  # a line that cuts a cell's corner off closely: through it
         (a, b, s), (c, d, t) = where[k], where[k + 1]
         common = {a, b} & {c, d}

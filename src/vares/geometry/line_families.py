@@ -183,6 +183,4 @@ def geodesic_between_ends(
 
 
 def _end_points(line: SurfaceLine) -> list[SurfaceLine]:
-    return [
-        SurfaceLine(line.ends[[k]], line.fractions[[k]], line.points[[k]]) for k in (0, -1)
-    ]
+    return [SurfaceLine(line.ends[[k]], line.fractions[[k]], line.points[[k]]) for k in (0, -1)]

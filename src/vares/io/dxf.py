@@ -20,12 +20,11 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.units import UNITS
 from .files import atomic_path
 
 __all__ = ["UNITS", "CutPiece", "boundary_loops", "cut_outline", "write_dxf"]
 
-#: DXF units: name → (metres per unit, $INSUNITS code).
-UNITS = {"mm": (1e-3, 4), "cm": (1e-2, 5), "m": (1.0, 6)}
 LAYERS = {"SEAM": 7, "CUT": 1, "WARP": 5, "MARKS": 3, "LABEL": 2}
 
 

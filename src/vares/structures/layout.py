@@ -232,9 +232,7 @@ def _widths(plan: StripPlan, family, seam_allowance: float, edge_allowance: floa
         outer = family is not None and not family.closed and index in (0, last)
         sides = 2 if last == 0 else 1
         allowance = (
-            sides * edge_allowance + (2 - sides) * seam_allowance
-            if outer
-            else 2 * seam_allowance
+            sides * edge_allowance + (2 - sides) * seam_allowance if outer else 2 * seam_allowance
         )
         out.append(width + allowance)
     return out
