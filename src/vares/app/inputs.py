@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.examples import EXAMPLES, STRUCTURE_EXAMPLES
+from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, STRUCTURE_EXAMPLES
 from ..geometry.mesh import MeshError
 from ..io.meshes import read_mesh, read_mesh_data
 from ..io.rhino import read_3dm
@@ -30,9 +30,10 @@ def load_input(job: Job) -> Input:
     source = job.input
     if source.example is not None:
         return _example(job)
-    if job.structure is None:
+    if job.structure is None or job.cut is not None:
         if source.meshes is not None:
-            raise JobError("several mesh files are a structure: pattern them with 'vares panels'")
+            what = "cut one surface" if job.cut is not None else "pattern them with 'vares panels'"
+            raise JobError(f"several mesh files are a structure: {what}")
         path = job.path(source.mesh)
         mesh, cell_data = read_mesh_data(path)
         return Input([Panel(source.name or path.stem, mesh)], cell_data)
@@ -41,10 +42,12 @@ def load_input(job: Job) -> Input:
 
 def _example(job: Job) -> Input:
     name, cell_type = job.input.example, job.input.cell_type
-    if job.structure is None:
+    if name in CUT_EXAMPLES and job.cut is None:
+        raise JobError(f"example {name!r} is a surface to cut: 'vares cut --example {name}'")
+    if job.structure is None or job.cut is not None:
         if name in STRUCTURE_EXAMPLES:
             raise JobError(f"example {name!r} is a structure: pattern it with 'vares panels'")
-        mesh = EXAMPLES[name](cell_type=cell_type)
+        mesh = {**EXAMPLES, **CUT_EXAMPLES}[name](cell_type=cell_type)
         return Input([Panel(job.input.name or name, mesh)])
     if name not in STRUCTURE_EXAMPLES:
         raise JobError(

@@ -9,6 +9,7 @@ from ..analysis.compensation import CompensationReport
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..solver.result import PatternResult
+from ..structures.cutting import CutResult
 from ..structures.matching import StructureResult
 from .job import Job
 
@@ -32,7 +33,8 @@ class PanelOutcome:
 @dataclass
 class JobOutcome:
     """What a job produced: one :class:`PanelOutcome` per pattern (one for a single surface),
-    the structure's result for a structure, and every file written."""
+    the structure's result for a structure (and the cut's for a cut job), and every file
+    written."""
 
     job: Job
     material: Hyperelastic
@@ -40,6 +42,7 @@ class JobOutcome:
     structure: StructureResult | None = None
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    cut: CutResult | None = None
 
     @property
     def converged(self) -> bool:

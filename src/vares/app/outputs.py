@@ -13,9 +13,10 @@ One pattern (in the output directory; for a structure, in a folder per panel):
 
 A structure adds ``structure.json`` (panels, seams before and after matching, the energy price,
 the roll width check), ``structure.dxf`` (all patterns with matching marks) and, with ``report``,
-its own ``report.html``. Every target is checked before the solve (nothing is overwritten without
-``force``); every file is written atomically. A solve that does not converge writes only the
-summaries.
+its own ``report.html``. A cut job writes its pieces nested on the roll instead of
+``structure.dxf``, and the files of :mod:`vares.app.cut_outputs`. Every target is checked
+before the solve (nothing is overwritten without ``force``); every file is written atomically. A
+solve that does not converge writes only the summaries.
 """
 
 from __future__ import annotations
@@ -37,6 +38,9 @@ from .inputs import Input
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
 from .sections import STRUCTURE_MARK_SPACING
+
+#: The files of a cut job besides the strips' and the structure's (see app/cut_outputs.py).
+CUT_FILES = ("cut.json", "nest.dxf", "nest.svg", "nest.png", "cut_lines.png", "panels.vtu")
 
 __all__ = ["panel_directory", "planned_files", "safe_name", "write_panel", "write_structure"]
 
@@ -79,7 +83,8 @@ def planned_files(job: Job, source: Input) -> list[Path]:
             names.append("report.html")
         files += [directory / n for n in names]
     if job.structure is not None:
-        names = ["structure.json", "structure.dxf"] + (["report.html"] if job.output.report else [])
+        names = ["structure.json"] + (["report.html"] if job.output.report else [])
+        names += list(CUT_FILES) if job.cut is not None else ["structure.dxf"]
         files += [job.directory / n for n in names]
     return files
 
@@ -211,7 +216,7 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
     """``structure.json`` and (when it converged) ``structure.dxf``; paths to ``outcome.files``."""
     job, structure = outcome.job, outcome.structure
     directory = job.directory
-    if structure.converged:
+    if structure.converged and job.cut is None:  # a cut job's pieces are drawn on the roll
         pieces = [
             CutPiece(
                 p.name,
@@ -231,7 +236,12 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
             allowance=job.output.allowance,
         )
         outcome.files.append(directory / "structure.dxf")
-    write_json(directory / "structure.json", structure_summary(outcome))
+    data = structure_summary(outcome)
+    if outcome.cut is not None:
+        from .cut_outputs import cutting_details
+
+        data["cutting"] = cutting_details(outcome)
+    write_json(directory / "structure.json", data)
     outcome.files.append(directory / "structure.json")
 
 

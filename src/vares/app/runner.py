@@ -18,6 +18,7 @@ from ..io.files import check_writable
 from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, solve
 from ..structures.matching import solve_structure
+from .cut_outputs import write_cut
 from .inputs import Input, load_input
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
@@ -46,7 +47,7 @@ def run_job(
     """
     material = job.material.build(job.base)
     source = load_input(job)
-    check_writable(planned_files(job, source), force)
+    check_writable(planned_files(job, Input([]) if job.cut is not None else source), force)
     options = job.solve
     if options.plane is None and job.input.example in EXAMPLE_PLANES:
         options = options.replace(plane=EXAMPLE_PLANES[job.input.example])
@@ -55,7 +56,9 @@ def run_job(
         on_solve_start(first.name, first.mesh, material)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if job.structure is None:
+        if job.cut is not None:
+            outcome = _solve_cut(job, source, material, options, callback, force)
+        elif job.structure is None:
             outcome = _solve_one(job, source, material, options, callback)
         else:
             outcome = _solve_structure(job, source, material, options, callback)
@@ -68,6 +71,8 @@ def run_job(
         outcome.files += panel.files
     if outcome.structure is not None:
         write_structure(outcome, marks)
+    if outcome.cut is not None:
+        write_cut(outcome)
     if job.output.report:
         from .report import write_reports
 
@@ -118,3 +123,50 @@ def _solve_structure(job, source: Input, material, options, callback) -> JobOutc
         for name, width in structure.too_wide
     ]
     return JobOutcome(job, material, panels, structure=structure, warnings=too_wide)
+
+
+def _solve_cut(job, source: Input, material, options, callback, force: bool) -> JobOutcome:
+    """Cut the surface into strips, pattern them, nest them (:func:`vares.structures.cut`);
+    every plan's panel files are checked before its patterns are computed."""
+    from ..structures.cutting import cut
+
+    if job.prestress.field is not None:
+        raise JobError("per-cell prestress is not available for cut jobs yet")
+    curves = None
+    if job.cut.seams == "curves":
+        from ..io.curves import read_curves
+
+        curves = read_curves(job.path(job.cut.curves), layer=job.cut.curves_layer)
+
+    def check(plan) -> None:
+        check_writable(planned_files(job, Input(plan.panels)), force)
+
+    result = cut(
+        source.panels[0].mesh,
+        material,
+        job.material.thickness,
+        prestress=job.prestress.value({}),
+        curves=curves,
+        allowance=job.output.allowance,
+        units=job.input.units,
+        dxf_units=job.output.dxf_units,
+        options=options,
+        structure=job.structure,
+        cutting=job.cut,
+        callback=callback,
+        before_solve=check,
+    )
+    panels = [
+        _panel(job, p.name, p.mesh, r)
+        for p, r in zip(result.plan.panels, result.structure.results, strict=True)
+    ]
+    units = job.input.units
+    warnings = [
+        f"{p.name} is {w:.4g} {units} wide across the warp with its allowances, more than the "
+        f"roll width {job.cut.roll_width:g}"
+        for p, w in zip(result.plan.panels, result.widths, strict=True)
+        if w > job.cut.roll_width
+    ]
+    return JobOutcome(
+        job, material, panels, structure=result.structure, warnings=warnings, cut=result
+    )

@@ -14,6 +14,7 @@ the lines (cells are neighbours across every edge that is no part of a line).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import defaultdict
 from collections.abc import Sequence
@@ -113,7 +114,7 @@ def cut_mesh(
     chords: dict[int, list[tuple[int, int]]] = defaultdict(list)
     seams: set[tuple[int, int]] = set()
     for chain in chains:
-        for u, w in zip(chain[:-1], chain[1:], strict=True):
+        for u, w in itertools.pairwise(chain):
             _place_segment(u, w, nodes, faces_at_node, faces_at_edge, chords, seams, num_input)
     for key in nodes.on_edge:
         nodes.on_edge[key].sort()
@@ -147,7 +148,7 @@ def _chain(line: SurfaceLine, nodes: _Nodes, snap: float) -> list[int]:
         (int(a), int(b), float(t)) for (a, b), t in zip(line.ends, line.fractions, strict=True)
     ]
     for k in range(len(where) - 1):  # a line that cuts a cell's corner off closely: through it
-        (a, b, s), (c, d, t) = where[k], where[k + 1]
+        (a, b, _), (c, d, _) = where[k], where[k + 1]
         common = {a, b} & {c, d}
         if a == b or c == d or len(common) != 1:
             continue
@@ -257,9 +258,9 @@ def _along_edge(edge: tuple[int, int], u: int, w: int, nodes: _Nodes) -> list[tu
         return 0.0 if node == a else 1.0 if node == b else nodes.where[node][2]
 
     lo, hi = sorted((position(u), position(w)))
-    along = [(0.0, a)] + nodes.on_edge.get(edge, []) + [(1.0, b)]
+    along = [(0.0, a), *nodes.on_edge.get(edge, []), (1.0, b)]
     chain = [n for t, n in sorted(along) if lo <= t <= hi]
-    return [(min(p, q), max(p, q)) for p, q in zip(chain[:-1], chain[1:], strict=True)]
+    return [(min(p, q), max(p, q)) for p, q in itertools.pairwise(chain)]
 
 
 def _split_face(

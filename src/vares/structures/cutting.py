@@ -189,7 +189,7 @@ def cut(
 
 def _plan(surface, target, cutting: CutOptions, allowances, options, curves) -> StripPlan:
     if cutting.seams == "curves":
-        from ..geometry.surface_lines import curves_on_surface
+        from ..geometry.drawn_lines import curves_on_surface
 
         base, lines = curves_on_surface(surface, curves or [], cutting.snap)
         return strips_along_lines(base, lines, cutting.snap, options.warp_direction)

@@ -5,8 +5,8 @@ iterating on what matters, the flattened width: place the lines, cut the mesh al
 every strip (least-squares conformal map, scaled to its area) and measure its extent across the
 warp, allowances included; then move the lines so that all strips get the same width (each
 gap's parameter span is scaled by (mean width / its width)^0.7, a few times, keeping the best),
-and take the least number of strips whose equalised width fits the roll. Fewer strips cannot fit: their mean width would be
-larger (the widths add up to about the same total whatever the number).
+and take the least number of strips whose equalised width fits the roll: one strip fewer is
+tried too, and does not fit.
 
 The flattened width is an estimate of the pattern's: :func:`vares.structures.cut.cut` checks the
 patterns themselves and plans again with a narrower target if one is too wide.
@@ -14,6 +14,7 @@ patterns themselves and plans again with a narrower target if one is too wide.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -184,7 +185,7 @@ def _along_strips(cut: CutMesh, panels: list[Panel], family) -> list[np.ndarray]
     lookup = dict(zip(keys.tolist(), owner.tolist(), strict=True))
     sums = np.zeros((len(panels), 3))
     for chain in cut.lines:
-        for u, w in zip(chain[:-1], chain[1:], strict=True):
+        for u, w in itertools.pairwise(chain):
             vector = points[w] - points[u]
             for key in (u * n + w, w * n + u):
                 if key in lookup:

@@ -93,7 +93,7 @@ def nest_pieces(
     items = [
         spyrrow.Item(
             str(index),
-            [tuple(p) for p in (shape - offset)],
+            _search_shape(shape - offset, clearance),
             demand=1,
             allowed_orientations=[0.0, 180.0] if allow_turn else [0.0],
         )
@@ -109,7 +109,12 @@ def nest_pieces(
         num_workers=1,
         seed=seed,
     )
-    solution = instance.solve(config)
+    try:
+        solution = instance.solve(config)
+    except BaseException as exc:  # a panic in the Rust code arrives as a BaseException
+        if isinstance(exc, KeyboardInterrupt | SystemExit):
+            raise
+        raise NestError(f"the nesting search failed: {exc}") from None
     pieces = []
     for placed in solution.placed_items:
         index = int(placed.id)
@@ -117,7 +122,7 @@ def nest_pieces(
         moved = NestedPiece(index, rotation, np.zeros(2))
         turned_offset = moved.place(-offsets[index][None])[0]
         translation = np.array(placed.translation, dtype=float) + turned_offset
-        pieces.append(NestedPiece(index, rotation, translation + [0.0, clearance]))
+        pieces.append(NestedPiece(index, rotation, translation + np.array([0.0, clearance])))
     pieces.sort(key=lambda p: p.index)
     placed_shapes = [Polygon(p.place(shapes[p.index])) for p in pieces]
     start = min(s.bounds[0] for s in placed_shapes)
@@ -128,6 +133,17 @@ def nest_pieces(
     return RollNest(
         roll_width, length, pieces, float(sum(net_areas)), time.perf_counter() - started
     )
+
+
+def _search_shape(shape: np.ndarray, clearance: float) -> list[tuple[float, float]]:
+    """The outline the search works with: grown by half the clearance and simplified within a
+    quarter of it (so it still covers the piece), without repeated or nearly repeated points."""
+    from shapely.geometry import Polygon
+
+    grown = Polygon(shape).buffer(0.5 * clearance, join_style="mitre").simplify(0.25 * clearance)
+    if grown.geom_type != "Polygon":
+        grown = max(grown.geoms, key=lambda g: g.area)
+    return [tuple(p) for p in np.asarray(grown.exterior.coords)[:-1]]
 
 
 def check_nest(shapes: Sequence, roll_width: float) -> None:
