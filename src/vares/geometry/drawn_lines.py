@@ -48,8 +48,12 @@ def curves_on_surface(
     base, chains = _insert(mesh, located, snap)
     solver = pp3d.EdgeFlipGeodesicSolver(base.points, base.cells["triangle"])
     lines = []
-    for chain in chains:
-        path = np.asarray(solver.find_geodesic_path_poly([int(n) for n in chain]))
+    for chain in chains:  # geodesic from point to point: the line passes through every one
+        pieces = [
+            np.asarray(solver.find_geodesic_path(int(a), int(b)))
+            for a, b in itertools.pairwise(chain)
+        ]
+        path = np.vstack([pieces[0]] + [p[1:] for p in pieces[1:]])
         lines.append(locate_on_edges(base, path))
     return base, lines
 

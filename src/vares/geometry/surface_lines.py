@@ -160,9 +160,9 @@ def plane_sections(mesh: SurfaceMesh, normal: np.ndarray, offset: float) -> list
     points = mesh.points
     triangles = mesh.cells["triangle"]
     size = float(np.ptp(points, axis=0).max()) or 1.0
-    normal = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+    normal = np.asarray(normal, dtype=float)
     level = points @ normal - offset
-    level[np.abs(level) <= 1e-12 * size] = 0.0
+    level[np.abs(level) <= 1e-12 * size * np.linalg.norm(normal)] = 0.0
     values = level[triangles]
     crossed = np.flatnonzero((values.min(axis=1) <= 0) & (values.max(axis=1) >= 0))
     location: dict[tuple[int, int], tuple[int, int, float]] = {}
