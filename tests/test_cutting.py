@@ -118,7 +118,7 @@ def test_cutting_along_lines_keeps_the_surface(kind):
 def test_crossing_lines_are_refused():
     mesh = hypar(size=10.0, rise=0.06, n=8)
     lines = plane_sections(mesh, (1, 0, 0), 0.3) + plane_sections(mesh, (0, 1, 0), 0.2)
-    with pytest.raises(CuttingError, match="cross|meet"):
+    with pytest.raises(CuttingError, match=r"cross|meet"):
         cut_mesh(mesh, lines)
 
 
