@@ -63,7 +63,7 @@ def cutting_details(outcome: JobOutcome) -> dict:
         "strips_tried": [{"strips": n, "widest_flattened": w} for n, w in plan.history],
         "widest_pattern_per_round": result.rounds,
         "worst_angle_degrees": plan.cut.worst_angle,
-        "input_worst_angle_degrees": plan.cut.input_worst_angle,
+        "input_worst_angle_degrees": result.surface_worst_angle,
         "surface_area": result.surface_area,
         "panels_area": result.panel_area,
         "seam_lines": [

@@ -20,7 +20,7 @@ from ..geometry.cutting import CutMesh
 from ..geometry.line_families import boundary_loops_3d
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.outline import allowance_outline
-from ..geometry.surface_lines import triangulated
+from ..geometry.surface_lines import min_angles, triangulated
 from ..geometry.units import unit_factor
 from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
@@ -67,7 +67,8 @@ class CutResult:
     """What :func:`cut` produced: the strips (``plan``), their patterns (``structure``), the
     outlines and widths across the warp with allowances (mesh units), the seams and the nest
     (``None`` if the structure did not converge). ``rounds`` lists the widest pattern of every
-    plan tried."""
+    plan tried; ``surface_worst_angle`` is the smallest cell angle (degrees) of the surface
+    before cutting (quads split into triangles), to compare with ``plan.cut.worst_angle``."""
 
     plan: StripPlan
     structure: StructureResult
@@ -82,6 +83,7 @@ class CutResult:
     allowance: float = 0.0
     rounds: list[float] = field(default_factory=list)
     elapsed: float = 0.0
+    surface_worst_angle: float = 0.0
 
     @property
     def converged(self) -> bool:
@@ -184,6 +186,7 @@ def cut(
         allowance,
         rounds,
         time.perf_counter() - started,
+        float(min_angles(surface.points, surface.cells["triangle"]).min()),
     )
 
 
