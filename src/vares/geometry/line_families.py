@@ -30,8 +30,6 @@ from .surface_lines import CuttingError, SurfaceLine, geodesic_lines, plane_sect
 __all__ = ["LAYOUTS", "LineFamily", "boundary_loops_3d", "geodesic_between_ends", "line_family"]
 
 LAYOUTS = ("auto", "parallel", "radial")
-#: Snap of a geodesic's end points onto boundary nodes (fraction of the cell size).
-END_SNAP = 0.25
 
 
 @dataclass(frozen=True)
@@ -173,11 +171,10 @@ def geodesic_between_ends(
     mesh: SurfaceMesh, sections: Sequence[SurfaceLine], snap: float
 ) -> tuple[SurfaceMesh, list[SurfaceLine]]:
     """The geodesics between the end points of ``sections`` (lines on ``mesh``): the end points
-    become nodes of the returned mesh, on which the geodesics lie. An end point within
-    :data:`END_SNAP` × the cell size of a boundary node is moved onto it (it slides along the
-    boundary: the line barely moves, and no sliver is made)."""
+    become nodes of the returned mesh, on which the geodesics lie (an end point within ``snap`` ×
+    the cell size of a boundary node is moved onto it)."""
     ends = [line for section in sections for line in _end_points(section)]
-    inserted = cut_mesh(mesh, ends, max(snap, END_SNAP), panels=False)
+    inserted = cut_mesh(mesh, ends, snap, panels=False)
     nodes = [int(chain[0]) for chain in inserted.lines]
     pairs = list(zip(nodes[0::2], nodes[1::2], strict=True))
     for start, end in pairs:
