@@ -57,7 +57,8 @@ def run_case(name: str, settings: dict, out: Path) -> None:
     units = job.input.units
     print(
         f"strips {len(plan.panels)} ({result.options.seams}, {plan.family.kind}); layouts tried "
-        f"{plan.evaluations}; strips tried {[(n, round(w, 4)) for n, w in plan.history]}"
+        f"{plan.evaluations}; strips tried {[(n, round(w, 4)) for n, w in plan.history]}; "
+        f"widest pattern per plan {[round(w, 4) for w in result.rounds]}"
     )
     print(
         f"widest pattern with allowances {max(result.widths):.4f} {units} (roll "

@@ -108,7 +108,8 @@ def cut_mesh(
     triangles = check_triangles(mesh)
     num_input = mesh.num_points
     nodes = _Nodes([p for p in mesh.points], {}, {}, {}, _cell_sizes(mesh.points, triangles))
-    chains = [_chain(line, nodes, snap) for line in lines]
+    boundary = {tuple(sorted(e)) for e in mesh.boundary_edges().tolist()}
+    chains = [_off_boundary(_chain(line, nodes, snap), nodes, boundary) for line in lines]
     _check_disjoint(chains, num_input, nodes)
     faces_at_node, faces_at_edge = _incidence(triangles)
     chords: dict[int, list[tuple[int, int]]] = defaultdict(list)
@@ -172,6 +173,27 @@ def _cell_sizes(points: np.ndarray, triangles: np.ndarray) -> dict[tuple[int, in
     size = np.zeros(len(edges))
     np.maximum.at(size, side.ravel(), np.repeat(length[side].max(axis=1), 3))
     return dict(zip(map(tuple, edges.tolist()), size.tolist(), strict=True))
+
+
+def _off_boundary(chain: list[int], nodes: _Nodes, boundary: set) -> list[int]:
+    """The chain without the pieces at its ends that run along the mesh's boundary (where a
+    line's crossing next to its end point was moved onto a boundary node): no seam there."""
+
+    def edge_of(node: int) -> tuple[int, int] | None:
+        return nodes.where[node][:2] if node in nodes.where else None
+
+    def along(u: int, w: int) -> bool:
+        for edge in (edge_of(u), edge_of(w), (min(u, w), max(u, w))):
+            if edge in boundary and all(n in edge or edge_of(n) == edge for n in (u, w)):
+                return True
+        return False
+
+    start, end = 0, len(chain) - 1
+    while start < end - 1 and along(chain[start], chain[start + 1]):
+        start += 1
+    while end > start + 1 and along(chain[end - 1], chain[end]):
+        end -= 1
+    return chain[start : end + 1]
 
 
 def _distance_to_segment(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
