@@ -54,7 +54,8 @@ class PieceOutline:
 @dataclass(frozen=True)
 class SeamLine:
     """A seam of the cut surface: its two panels, its 3D length, the length of the cutting line
-    it follows (as computed, before the cut) and its pattern length on each side."""
+    it follows (as computed, before the cut, between the points nearest to the seam's ends) and
+    its pattern length on each side."""
 
     panels: tuple[str, str]
     length_3d: float
@@ -160,7 +161,8 @@ def cut(
         rounds.append(max(widths))
         if not result.converged or max(widths) <= cutting.roll_width or curves is not None:
             break
-        target *= cutting.roll_width / max(widths) * (1.0 - 1e-3)
+        # the flattened widths underestimated the patterns': ask the flattening for less
+        target = max(plan.widths) * cutting.roll_width / max(widths) * (1.0 - 1e-3)
     nest = None
     if result.converged and max(widths) <= cutting.roll_width:
         nest = nest_pieces(
@@ -242,6 +244,22 @@ def piece_outlines(
     return outlines
 
 
+def _stretch(polyline: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
+    """Length of a polyline between the points nearest to ``start`` and ``end`` (the stretch of
+    a cutting line a seam follows: its ends may have been moved onto boundary nodes)."""
+    a, b = polyline[:-1], polyline[1:]
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    cumulative = np.concatenate([[0.0], np.cumsum(length)])
+
+    def position(point: np.ndarray) -> float:
+        t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.maximum(length**2, 1e-300), 0, 1)
+        k = int(np.argmin(np.linalg.norm(a + t[:, None] * d - point, axis=1)))
+        return float(cumulative[k] + t[k] * length[k])
+
+    return abs(position(end) - position(start))
+
+
 def seam_lines(plan: StripPlan, structure: StructureResult) -> list[SeamLine]:
     """The seams with their 3D lengths, the lengths of the lines they follow and their
     pattern lengths on both sides."""
@@ -258,7 +276,8 @@ def seam_lines(plan: StripPlan, structure: StructureResult) -> list[SeamLine]:
         if tree is not None:
             _, found = tree.query(nodes)
             line = int(np.bincount(owner[found]).argmax())
-            line_length = plan.lines[line].length if line < len(plan.lines) else line_length
+            if line < len(plan.lines):
+                line_length = _stretch(plan.lines[line].points, nodes[0], nodes[-1])
         out.append(
             SeamLine(
                 (report.first, report.second),
