@@ -44,7 +44,7 @@ CASES = {
 
 
 def run_case(name: str, settings: dict, out: Path) -> None:
-    values = {**COMMON, **settings, "output": str(out / name)}
+    values = {**COMMON, **settings, "directory": str(out / name)}
     example = values.pop("example")
     job = job_from_flags(values, cut=True, example=example)
     flags = " ".join(f"--{k.replace('_', '-')} {v}" for k, v in {**COMMON, **settings}.items())
