@@ -72,7 +72,8 @@ class _Nodes:
         closer than ``snap`` × the size of the cells there."""
         if a == b:
             return a
-        reach = snap * self.cell_size[(min(a, b), max(a, b))]
+        # within round-off of a node a crossing is the node, whatever the snap
+        reach = max(snap, 1e-6) * self.cell_size[(min(a, b), max(a, b))]
         length = float(np.linalg.norm(self.points[b] - self.points[a]))
         if t * length <= reach:
             return a

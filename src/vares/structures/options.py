@@ -123,9 +123,7 @@ class CutOptions(Options):
         section="cut",
         positive=True,
     )
-    nest_seed: int = option(
-        0, "int", "Seed of the nesting search (same seed, same nest).", section="cut", minimum=0
-    )
+    nest_seed: int = option(0, "int", "Seed of the nesting search.", section="cut", minimum=0)
     piece_gap: float = option(
         0.0, "float", "Gap between nested pieces (DXF units).", section="cut", minimum=0
     )
