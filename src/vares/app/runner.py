@@ -167,6 +167,8 @@ def _solve_cut(job, source: Input, material, options, callback, force: bool) -> 
         for p, w in zip(result.plan.panels, result.widths, strict=True)
         if w > job.cut.roll_width
     ]
+    if warnings and result.structure.converged:
+        warnings.append("no nest: a piece wider than the roll cannot be laid on it")
     return JobOutcome(
         job, material, panels, structure=result.structure, warnings=warnings, cut=result
     )

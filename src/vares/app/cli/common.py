@@ -146,9 +146,13 @@ def _show_structure(outcome: JobOutcome) -> None:
 def _show_cut(outcome: JobOutcome) -> None:
     result, units = outcome.cut, outcome.job.input.units
     plan = result.plan
+    lines = (
+        f"between {len(plan.lines)} drawn curves"
+        if result.options.seams == "curves"
+        else f"of {result.options.seams} lines ({plan.evaluations} layouts tried)"
+    )
     console.print(
-        f"cut: {len(plan.panels)} strips of {result.options.seams} lines "
-        f"({plan.evaluations} layouts tried), widest {max(result.widths):.4g} {units} with "
+        f"cut: {len(plan.panels)} strips {lines}, widest {max(result.widths):.4g} {units} with "
         f"allowances (roll {result.options.roll_width:g}); worst cell angle "
         f"{plan.cut.worst_angle:.1f}° (surface {result.surface_worst_angle:.1f}°); area 3D "
         f"{result.panel_area:.6g} of {result.surface_area:.6g} {units}²"
