@@ -3,9 +3,10 @@
 The roll runs along x, its usable width along y (``0 ≤ y ≤ roll width``); every piece keeps its
 warp along the roll (patterns come with the warp along +x) and may be turned by 180° when
 allowed. The layout is found by sparrow (Gardeyn & Wauters 2025, "An open-source heuristic to
-reboot 2D nesting research"), a maintained strip-packing heuristic (Rust, MIT) through its Python
-bindings ``spyrrow`` (MIT); its collision engine jagua-rs is MPL-2.0. The result is checked
-independently here with shapely: no two pieces overlap, every piece lies inside the roll.
+reboot 2D nesting research"), a maintained strip-packing heuristic in Rust, through its Python
+bindings ``spyrrow`` (MIT), which bundle it with its collision engine jagua-rs (MPL-2.0). The
+result is checked independently here with shapely: no two pieces overlap, every piece lies
+inside the roll.
 """
 
 from __future__ import annotations
