@@ -162,7 +162,7 @@ def main() -> None:
     print(
         f"machine: {platform.machine()}, {os.cpu_count()} cores, Python "
         f"{platform.python_version()}, vares {vares.__version__}, linear solvers available: "
-        f"{', '.join(vares.linalg.available_solvers())}"
+        f"{', '.join(vares.solver.available_solvers())}"
     )
     header = (
         f"{'surface':<7} {'triangles':>9} {'method':<6} {'time s':>8} {'setup s':>8} "

@@ -23,15 +23,20 @@ from .mechanics import Problem
 from .options import OptionsError
 from .solver import IterationRecord, PatternResult, SolveOptions, StepRecord, solve
 from .structures import (
+    CutOptions,
+    CutResult,
     Panel,
     StructureOptions,
     StructureResult,
+    cut,
     find_seams,
     solve_structure,
     split_panels,
 )
 
 __all__ = [
+    "CutOptions",
+    "CutResult",
     "Fibres",
     "IterationRecord",
     "MeshError",
@@ -49,6 +54,7 @@ __all__ = [
     "__version__",
     "cell_fields",
     "compensation_report",
+    "cut",
     "evaluate",
     "examples",
     "find_seams",

@@ -326,8 +326,9 @@ def takes_options(*classes: type[Options]) -> Callable[[Callable], Callable]:
         for cls in classes:
             defaults = cls.defaults()
             for name, spec in cls.specs().items():
-                if name in names:
+                if name in names:  # declared by the function or an earlier class
                     continue
+                names.add(name)
                 added.append(
                     inspect.Parameter(
                         name,

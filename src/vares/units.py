@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["METRES", "PLAUSIBLE_SIZE", "implausible_size"]
+__all__ = ["METRES", "PLAUSIBLE_SIZE", "implausible_size", "unit_factor"]
 
 #: Length unit → metres per unit.
 METRES = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254, "ft": 0.3048}
@@ -23,6 +23,14 @@ def implausible_size(extent: float, units: str) -> str | None:
     size = f"{metres / 1000:.3g} km" if metres > high else f"{metres * 1000:.3g} mm"
     advice = f"; if the file is in {likely}, pass --units {likely}" if likely else ""
     return f"the surface is {size} across in {units}: implausible for a membrane or part{advice}"
+
+
+def unit_factor(source: str, target: str) -> float:
+    """How many ``target`` units one ``source`` unit is (``unit_factor("m", "mm") = 1000``)."""
+    for name in (source, target):
+        if name not in METRES:
+            raise ValueError(f"units must be one of {', '.join(METRES)}; got {name!r}")
+    return METRES[source] / METRES[target]
 
 
 def _log10(value: float) -> float:

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.examples import EXAMPLES, STRUCTURE_EXAMPLES
+from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, STRUCTURE_EXAMPLES
 from ..geometry.mesh import MeshError
 from ..io.meshes import MeshFile, read_mesh_file, read_pattern
 from ..io.rhino import read_3dm, unit_system
@@ -40,9 +40,10 @@ def load_input(job: Job) -> Input:
     source = job.input
     if source.example is not None:
         loaded = _example(job)
-    elif job.structure is None:
+    elif job.structure is None or job.cut is not None:
         if source.meshes is not None:
-            raise JobError("several mesh files are a structure: pattern them with 'vares panels'")
+            what = "cut one surface" if job.cut is not None else "pattern them with 'vares panels'"
+            raise JobError(f"several mesh files are a structure: {what}")
         mesh_file = _read(job, source.mesh)
         panel = Panel(source.name or mesh_file.path.stem, mesh_file.surface())
         loaded = Input([panel], _units(job, [mesh_file.units]), mesh_file.cell_data)
@@ -94,10 +95,12 @@ def _note(loaded: Input, files: list[MeshFile]) -> None:
 def _example(job: Job) -> Input:
     name, cell_type = job.input.example, job.input.cell_type
     units = _units(job, [])
-    if job.structure is None:
+    if name in CUT_EXAMPLES and job.cut is None:
+        raise JobError(f"example {name!r} is a surface to cut: 'vares cut --example {name}'")
+    if job.structure is None or job.cut is not None:
         if name in STRUCTURE_EXAMPLES:
             raise JobError(f"example {name!r} is a structure: pattern it with 'vares panels'")
-        mesh = EXAMPLES[name](cell_type=cell_type)
+        mesh = {**EXAMPLES, **CUT_EXAMPLES}[name](cell_type=cell_type)
         return Input([Panel(job.input.name or name, mesh)], units)
     if name not in STRUCTURE_EXAMPLES:
         raise JobError(

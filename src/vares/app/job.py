@@ -32,6 +32,10 @@ in :mod:`vares.options`); an unknown table or key is an error naming the closest
     [structure]                  # present: the input is a structure of several panels
     match_seams = true
 
+    [cut]                        # present: cut the surface into strips of roll width
+    roll_width = 2.5             # mesh units
+    seams = "geodesic"           # or "planar", or "curves" with curves = "lines.3dm"
+
 Relative paths are relative to the job file's folder, so a job folder can be moved or shared.
 """
 
@@ -47,7 +51,7 @@ from typing import Any
 
 from ..options import Options, OptionsError, Spec
 from ..solver.options import SolveOptions
-from ..structures.options import StructureOptions
+from ..structures.options import CutOptions, StructureOptions
 from .sections import InputOptions, MaterialOptions, OutputOptions, PrestressOptions
 
 __all__ = ["SECTIONS", "Job", "JobError", "load_job"]
@@ -66,14 +70,16 @@ SECTIONS: dict[str, str] = {
     "solver": "solve",
     "output": "output",
     "structure": "structure",
+    "cut": "cut",
 }
 
 
 @dataclass(frozen=True)
 class Job:
     """A patterning job: one options object per part; ``structure`` is set for a structure of
-    several panels. ``base`` is the folder relative paths are relative to; ``location`` the
-    job file it was read from (if any)."""
+    several panels, ``cut`` (and ``structure``) for a surface cut into strips of roll width.
+    ``base`` is the folder relative paths are relative to; ``location`` the job file it was
+    read from (if any)."""
 
     input: InputOptions
     material: MaterialOptions = field(default_factory=MaterialOptions)
@@ -81,6 +87,7 @@ class Job:
     prestress: PrestressOptions = field(default_factory=PrestressOptions)
     output: OutputOptions = field(default_factory=OutputOptions)
     structure: StructureOptions | None = None
+    cut: CutOptions | None = None
     base: Path = field(default_factory=Path.cwd)
     location: Path | None = None
 
@@ -110,6 +117,8 @@ class Job:
                 built[part] = _build(_PARTS[part], values, origin)
         if "input" not in built:
             raise JobError(f"{origin}: [input] needs exactly one of mesh, meshes or example")
+        if "cut" in built and "structure" not in built:
+            built["structure"] = StructureOptions()
         return cls(**built, base=base or Path.cwd())
 
     def to_dict(self, location: Path | None = None) -> dict[str, dict[str, Any]]:
@@ -166,6 +175,7 @@ _PARTS: dict[str, type[Options]] = {
     "prestress": PrestressOptions,
     "output": OutputOptions,
     "structure": StructureOptions,
+    "cut": CutOptions,
 }
 
 

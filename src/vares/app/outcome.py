@@ -9,6 +9,7 @@ from ..analysis.compensation import CompensationReport
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..solver.result import PatternResult
+from ..structures.cutting import CutResult
 from ..structures.matching import StructureResult
 from .job import Job
 
@@ -33,8 +34,8 @@ class PanelOutcome:
 @dataclass
 class JobOutcome:
     """What a job produced: one :class:`PanelOutcome` per pattern (one for a single surface),
-    the structure's result for a structure, the output folder, the length units, what the
-    input's repair changed, and every file written."""
+    the structure's result for a structure (and the cut's for a cut job), the output folder,
+    the length units, what the input's repair changed, and every file written."""
 
     job: Job
     material: Hyperelastic
@@ -43,6 +44,7 @@ class JobOutcome:
     directory: Path = Path()
     units: str = "m"
     repairs: dict[str, dict[str, object]] = field(default_factory=dict)
+    cut: CutResult | None = None
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 

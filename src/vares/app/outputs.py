@@ -13,9 +13,10 @@ One pattern (in the output directory; for a structure, in a folder per panel):
 
 A structure adds ``structure.json`` (panels, seams before and after matching, the energy price,
 the roll width check), ``structure.dxf`` (all patterns with matching marks) and, with ``report``,
-its own ``report.html``. Every target is checked before the solve (nothing is overwritten without
-``force``); every file is written atomically. A solve that does not converge writes only the
-summaries.
+its own ``report.html``. A cut job writes its pieces nested on the roll instead of
+``structure.dxf``, and the files of :mod:`vares.app.cut_outputs`. Every target is checked
+before the solve (nothing is overwritten without ``force``); every file is written atomically.
+A solve that does not converge writes only the summaries.
 """
 
 from __future__ import annotations
@@ -41,6 +42,9 @@ from .outcome import JobOutcome, PanelOutcome
 from .sections import STRUCTURE_MARK_SPACING
 
 __all__ = ["panel_directory", "planned_files", "safe_name", "write_panel", "write_structure"]
+
+#: The files of a cut job besides the strips' and the structure's (see app/cut_outputs.py).
+CUT_FILES = ("cut.json", "nest.dxf", "nest.svg", "nest.png", "cut_lines.png", "panels.vtu")
 
 PATTERN_FILES = (
     "summary.json",
@@ -73,7 +77,7 @@ def planned_files(job: Job, source: Input, save_job: Path | None = None) -> list
     if clashes:
         raise JobError(f"two panels would write into the same folder {clashes[0]!r}: rename them")
     files = []
-    for panel in source.panels:
+    for panel in [] if job.cut is not None else source.panels:  # a cut's strips come later
         directory = panel_directory(job, panel.name)
         names = list(PATTERN_FILES)
         for field in job.output.plots:
@@ -84,7 +88,8 @@ def planned_files(job: Job, source: Input, save_job: Path | None = None) -> list
             names.append("report.html")
         files += [directory / n for n in names]
     if job.structure is not None:
-        names = ["structure.json", "structure.dxf"] + (["report.html"] if job.output.report else [])
+        names = ["structure.json"] + (["report.html"] if job.output.report else [])
+        names += list(CUT_FILES) if job.cut is not None else ["structure.dxf"]
         files += [job.directory / n for n in names]
     if save_job is not None and job.directory.resolve() in save_job.resolve().parents:
         files.append(save_job)
@@ -242,8 +247,10 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
     """``structure.json`` and (when it converged) ``structure.dxf``; paths to ``outcome.files``."""
     job, structure = outcome.job, outcome.structure
     directory = outcome.directory
-    # marks exist when every panel converged or failed only by overlapping itself
-    if structure.converged or (job.output.allow_overlap and marks is not None):
+    # marks exist when every panel converged or failed only by overlapping itself; a cut job's
+    # pieces are drawn on the roll instead
+    drawn = structure.converged or (job.output.allow_overlap and marks is not None)
+    if drawn and job.cut is None:
         pieces = [
             CutPiece(
                 p.name,
@@ -263,7 +270,12 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
             allowance=job.output.allowance,
         )
         outcome.files.append(directory / "structure.dxf")
-    write_json(directory / "structure.json", structure_summary(outcome))
+    data = structure_summary(outcome)
+    if outcome.cut is not None:
+        from .cut_outputs import cutting_details
+
+        data["cutting"] = cutting_details(outcome)
+    write_json(directory / "structure.json", data)
     outcome.files.append(directory / "structure.json")
 
 

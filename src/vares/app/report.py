@@ -332,9 +332,41 @@ def structure_report(outcome: JobOutcome) -> str:
             header=("seam", "segments", "length A", "length B", "mismatch before", "after"),
             ident="seams",
         ),
+        *(_cut_section(outcome) if outcome.cut is not None else []),
         "</body></html>",
     ]
     return "\n".join(parts)
+
+
+def _cut_section(outcome: JobOutcome) -> list[str]:
+    """The cutting plan and the nest of a cut job: figures and pictures."""
+    from ..io.plot import plot_cut_lines, plot_nest
+    from .cut_outputs import nested_drawings
+
+    result, units = outcome.cut, outcome.units
+    plan, nest = result.plan, result.nest
+    key = [
+        ("roll width", f"{result.options.roll_width:g} {units}"),
+        ("cutting lines", f"{result.options.seams}, {len(plan.lines)}"),
+        ("strips", len(plan.panels)),
+        ("widest pattern with allowances", f"{_g(max(result.widths))} {units}"),
+        (
+            "worst cell angle",
+            f"{plan.cut.worst_angle:.1f}° (surface {result.surface_worst_angle:.1f}°)",
+        ),
+    ]
+    if nest is not None:
+        key += [
+            ("roll length used", f"{_g(nest.length)} {units}"),
+            ("yield", f"{100 * nest.yield_:.1f} % (waste {100 * nest.waste:.1f} %)"),
+        ]
+    parts = ["<h2>Cutting and nesting</h2>", _table(key, ident="cut-figures")]
+    lines = plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines)
+    parts.append(_figure(lines, "cutting lines on the surface", "cut-lines"))
+    if nest is not None:
+        drawing = plot_nest(nest.roll_width, nest.length, nested_drawings(outcome), units=units)
+        parts.append(_figure(drawing, "the pieces on the roll", "nest"))
+    return parts
 
 
 def write_reports(outcome: JobOutcome) -> None:

@@ -85,7 +85,8 @@ def run_job(
 
 def _inputs(job: Job) -> list[Path]:
     paths = [job.path(p) for p in job.input.paths]
-    for extra in (job.material.presets, job.input.initial_pattern):
+    curves = None if job.cut is None else job.cut.curves
+    for extra in (job.material.presets, job.input.initial_pattern, curves):
         if extra is not None:
             paths.append(job.path(extra))
     if job.location is not None:
@@ -101,6 +102,8 @@ def _options(job: Job) -> SolveOptions:
 
 
 def _solve(job: Job, source: Input, material, options, callback) -> JobOutcome:
+    if job.cut is not None:
+        return _solve_cut(job, source, material, options, callback)
     if job.structure is None:
         return _solve_one(job, source, material, options, callback)
     return _solve_structure(job, source, material, options, callback)
@@ -123,6 +126,10 @@ def _write(outcome: JobOutcome, root: Path, save_job: Path | None, folder: Outpu
         outcome.files += panel.files
     if outcome.structure is not None:
         write_structure(outcome, marks)
+    if outcome.cut is not None:
+        from .cut_outputs import write_cut
+
+        write_cut(outcome)
     if job.output.report:
         from .report import write_reports
 
@@ -208,4 +215,51 @@ def _solve_structure(job, source: Input, material, options, callback) -> JobOutc
         warnings=too_wide,
         units=source.units,
         repairs=source.repairs,
+    )
+
+
+def _solve_cut(job, source: Input, material, options, callback) -> JobOutcome:
+    """Cut the surface into strips, pattern them, nest them (:func:`vares.structures.cut`)."""
+    from ..structures.cutting import cut
+
+    if job.prestress.field is not None:
+        raise JobError("per-cell prestress is not available for cut jobs yet")
+    curves = None
+    if job.cut.seams == "curves":
+        from ..io.curves import read_curves
+
+        curves = read_curves(job.path(job.cut.curves), layer=job.cut.curves_layer)
+    result = cut(
+        source.panels[0].mesh,
+        material,
+        job.material.thickness,
+        prestress=job.prestress.value({}),
+        curves=curves,
+        allowance=job.output.allowance,
+        units=source.units,
+        dxf_units=job.output.dxf_units,
+        options=options,
+        structure=job.structure,
+        cutting=job.cut,
+        callback=callback,
+    )
+    pairs = zip(result.plan.panels, result.structure.results, strict=True)
+    panels = [_panel(job, source, p.name, p.mesh, r) for p, r in pairs]
+    warnings = [
+        f"{p.name} is {w:.4g} {source.units} wide across the warp with its allowances, more "
+        f"than the roll width {job.cut.roll_width:g}"
+        for p, w in zip(result.plan.panels, result.widths, strict=True)
+        if w > job.cut.roll_width
+    ]
+    if warnings and result.structure.converged:
+        warnings.append("no nest: a piece wider than the roll cannot be laid on it")
+    return JobOutcome(
+        job,
+        material,
+        panels,
+        structure=result.structure,
+        warnings=warnings,
+        units=source.units,
+        repairs=source.repairs,
+        cut=result,
     )

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.examples import EXAMPLES, STRUCTURE_EXAMPLES
+from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, STRUCTURE_EXAMPLES
 from ..materials import LAWS, Hyperelastic, fabric, make_material
 from ..mechanics.fields import FIELD_DESCRIPTIONS
 from ..options import Options, OptionsError, option
@@ -42,7 +42,7 @@ class InputOptions(Options):
         "str",
         "A shipped example surface (or structure) instead of a file.",
         section="input",
-        choices=(*EXAMPLES, *STRUCTURE_EXAMPLES),
+        choices=(*EXAMPLES, *STRUCTURE_EXAMPLES, *CUT_EXAMPLES),
         flags=(),
     )
     cell_type: str = option(

@@ -10,6 +10,9 @@
 ``sail``, ``tent``
     A four-point sail (a hypar with two high and two low corners) and one panel of a conic tent
     pulled up to a central ring: the prestressed membranes of the compensation examples.
+``saddle``, ``conic-tent``
+    Whole membranes to cut into strips of roll width: a four-point sail over a 20 m square, and
+    a conic tent all round its high ring.
 ``rib30``
     A generic 30° segment of a curved composite rib (seed §5.2): a hat-shaped cross-section
     (web, inclined walls, flanges, rounded corners) swept along a circular arc. The rounded
@@ -27,6 +30,7 @@ import numpy as np
 from .mesh import SurfaceMesh
 
 __all__ = [
+    "CUT_EXAMPLES",
     "EXAMPLES",
     "EXAMPLE_PLANES",
     "STRUCTURE_EXAMPLES",
@@ -46,7 +50,9 @@ __all__ = [
     "rib30",
     "robustness_suite",
     "ruffled_fan",
+    "saddle",
     "spherical_cap",
+    "tent_roof",
 ]
 
 
@@ -246,6 +252,28 @@ def conic_tent(
     if whole:  # close the ring: the last row of nodes is the first
         cells = {t: np.where(c >= len(points), c - len(points), c) for t, c in cells.items()}
     return SurfaceMesh(points, cells)
+
+
+def saddle(
+    size: float = 20.0, height: float = 5.0, n: int = 40, cell_type: str = "triangle"
+) -> SurfaceMesh:
+    """The saddle of the cutting examples: a four-point sail over a ``size`` × ``size`` square
+    (20 m) whose high and low corners are ``height`` apart (5 m), ``n`` × ``n`` cells."""
+    return four_point_sail(size=size, height=height, n=n, cell_type=cell_type)
+
+
+def tent_roof(
+    outer_radius: float = 6.0,
+    ring_radius: float = 1.0,
+    height: float = 3.5,
+    n_radial: int = 24,
+    n_around: int = 32,
+    cell_type: str = "triangle",
+) -> SurfaceMesh:
+    """The conic tent of the cutting examples: the whole membrane (all round) from the ground
+    ring of ``outer_radius`` (6 m) up to the high ring of ``ring_radius`` (1 m) ``height`` (3.5 m)
+    above it; ``4 n_around`` cells round, ``n_radial`` up (see :func:`conic_tent`)."""
+    return conic_tent(outer_radius, ring_radius, height, 1, n_radial, n_around, cell_type=cell_type)
 
 
 def spherical_cap(
@@ -526,6 +554,8 @@ EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {
     "sail": four_point_sail,
     "tent": conic_tent,
 }
+#: Whole surfaces to cut into strips of roll width (``vares cut --example``).
+CUT_EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {"saddle": saddle, "conic-tent": tent_roof}
 #: Example structures by name: generators of a mesh and a panel id per cell (``vares panels``).
 STRUCTURE_EXAMPLES: dict[str, Callable[..., tuple[SurfaceMesh, np.ndarray]]] = {
     "hypar-strips": hypar_strips,

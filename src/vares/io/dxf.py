@@ -23,7 +23,15 @@ from ..geometry.mesh import SurfaceMesh
 from ..units import METRES
 from .files import atomic_path
 
-__all__ = ["INSUNITS", "CutPiece", "cut_outline", "write_dxf"]
+__all__ = [
+    "INSUNITS",
+    "CutPiece",
+    "NestedDrawing",
+    "cut_outline",
+    "label_place",
+    "write_dxf",
+    "write_nest_dxf",
+]
 
 #: DXF ``$INSUNITS`` code of each length unit.
 INSUNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1, "ft": 2}
@@ -179,3 +187,131 @@ def _normals_at(ring: np.ndarray, points: np.ndarray) -> np.ndarray:
         d = (b - a)[nearest] / np.linalg.norm((b - a)[nearest])
         out.append([d[1], -d[0]])
     return np.array(out).reshape(-1, 2)
+
+
+@dataclass
+class NestedDrawing:
+    """A piece as laid on the roll (model units): its seam and cut rings, its warp direction,
+    its label lines and its match marks ``(name, point (2,), outward normal (2,))``."""
+
+    name: str
+    seam: np.ndarray
+    cut: np.ndarray
+    warp: np.ndarray
+    label: Sequence[str]
+    marks: Sequence[tuple[str, np.ndarray, np.ndarray]] = ()
+    tick: float = 0.0
+
+
+#: Width of a character of the drawing's text, in text heights (generous, so labels fit).
+_CHARACTER_WIDTH = 0.8
+
+
+def write_nest_dxf(
+    path: str | Path,
+    rolls: Sequence[tuple[float, float, Sequence[NestedDrawing]]],
+    *,
+    units: str = "mm",
+    model_units: str = "m",
+) -> None:
+    """Write nested pieces to a DXF file (R2010): one drawing per roll ``(width, length,
+    pieces)``, the rolls one above the other. Each roll is a rectangle on layer ``ROLL`` (the
+    roll runs along x); each piece has its seam and cut lines, a warp arrow and its label (name
+    and area) inside it, placed where they cross no line (the pole of inaccessibility of the
+    seam polygon, shapely's ``polylabel``), and its match marks named by seam."""
+    import ezdxf
+    from ezdxf.enums import TextEntityAlignment
+
+    factor = METRES[model_units] / METRES[units]
+    doc = ezdxf.new("R2010", setup=True)
+    doc.header["$INSUNITS"] = INSUNITS[units]
+    doc.header["$MEASUREMENT"] = 1
+    for name, colour in {**LAYERS, "ROLL": 8}.items():
+        doc.layers.add(name, color=colour)
+    space = doc.modelspace()
+    centred = {"align": TextEntityAlignment.MIDDLE_CENTER}
+    offset = 0.0
+    for number, (width, length, pieces) in enumerate(rolls, start=1):
+        shift = np.array([0.0, offset])
+        corners = np.array([[0, 0], [length, 0], [length, width], [0, width]]) * factor + shift
+        space.add_lwpolyline(corners, close=True, dxfattribs={"layer": "ROLL"})
+        title = f"roll {number}: {width:g} × {length:.4g} {model_units}"
+        space.add_text(
+            title, height=0.04 * width * factor, dxfattribs={"layer": "ROLL"}
+        ).set_placement(tuple(corners[3] + [0.0, 0.03 * width * factor]))
+        for piece in pieces:
+            _draw_nested(space, piece, factor, shift, centred)
+        offset += 1.3 * width * factor
+    with atomic_path(Path(path)) as temporary:
+        doc.saveas(temporary)
+
+
+def _draw_nested(space, piece: NestedDrawing, factor: float, shift: np.ndarray, centred) -> None:
+    from shapely.geometry import Polygon, box
+
+    seam = piece.seam * factor + shift
+    space.add_lwpolyline(seam, close=True, dxfattribs={"layer": "SEAM"})
+    space.add_lwpolyline(piece.cut * factor + shift, close=True, dxfattribs={"layer": "CUT"})
+    polygon = Polygon(seam)
+    centre, height = label_place(polygon, len(piece.label) + 1, max(map(len, piece.label)))
+    warp = np.asarray(piece.warp, dtype=float) / np.linalg.norm(piece.warp)
+    rows = len(piece.label) + 1
+    top = centre[1] + 0.5 * (rows - 1) * 1.6 * height
+    half = 0.5 * _CHARACTER_WIDTH * height * max(map(len, piece.label))
+    tail, tip = centre + np.array([-half * warp[0], 0.0]), centre + np.array([half * warp[0], 0.0])
+    tail[1] = tip[1] = top
+    head = 0.5 * height
+    space.add_lwpolyline([tail, tip], dxfattribs={"layer": "WARP"})
+    space.add_lwpolyline(
+        [tip - head * warp + [0, 0.5 * head], tip, tip - head * warp - [0, 0.5 * head]],
+        dxfattribs={"layer": "WARP"},
+    )
+    for row, line in enumerate(piece.label, start=1):
+        space.add_text(line, height=height, dxfattribs={"layer": "LABEL"}).set_placement(
+            (centre[0], top - row * 1.6 * height), **centred
+        )
+    block = box(
+        centre[0] - half, top - (rows - 0.5) * 1.6 * height, centre[0] + half, top + 0.8 * height
+    )
+    mark_height = 0.5 * height
+    tick = piece.tick * factor
+    for name, point, normal in piece.marks:
+        at = np.asarray(point) * factor + shift
+        space.add_line(at, at + tick * np.asarray(normal), dxfattribs={"layer": "MARKS"})
+        size = mark_height
+        for _ in range(3):  # the name inside the piece, clear of every line and of the label
+            spot = at - np.asarray(normal) * (
+                0.8 * size + 0.5 * _CHARACTER_WIDTH * size * len(name) * abs(normal[0])
+            )
+            half_w = 0.5 * _CHARACTER_WIDTH * size * len(name)
+            area = box(
+                spot[0] - half_w, spot[1] - 0.6 * size, spot[0] + half_w, spot[1] + 0.6 * size
+            )
+            if polygon.contains(area) and not area.intersects(block):
+                space.add_text(name, height=size, dxfattribs={"layer": "MARKS"}).set_placement(
+                    tuple(spot), **centred
+                )
+                break
+            size *= 0.5
+
+
+def label_place(polygon, rows: int, characters: int) -> tuple[np.ndarray, float]:
+    """Centre and text height of a label block of ``rows`` rows of at most ``characters``
+    characters that fits inside a shapely polygon: centred on its pole of inaccessibility, as
+    large as fits (at most a tenth of the polygon's smaller extent)."""
+    from shapely.geometry import box
+    from shapely.ops import polylabel
+
+    low_x, low_y, high_x, high_y = polygon.bounds
+    size = min(high_x - low_x, high_y - low_y)
+    pole = polylabel(polygon, tolerance=1e-3 * size)
+    centre = np.array([pole.x, pole.y])
+    height = 0.1 * size
+    for _ in range(40):
+        half_w = 0.5 * _CHARACTER_WIDTH * height * characters
+        half_h = 0.5 * rows * 1.6 * height
+        block = box(centre[0] - half_w, centre[1] - half_h, centre[0] + half_w, centre[1] + half_h)
+        if polygon.buffer(-0.2 * height).contains(block):
+            break
+        height *= 0.85
+    return centre, height

@@ -20,6 +20,8 @@ from ..mechanics.fields import FIELD_DESCRIPTIONS
 __all__ = [
     "FIELD_LABELS",
     "plot_convergence",
+    "plot_cut_lines",
+    "plot_nest",
     "plot_pattern",
     "plot_surface",
     "save_pattern_figure",
@@ -256,4 +258,72 @@ def plot_convergence(history, ax=None, title: str | None = "convergence") -> plt
         ax.legend(fontsize="small")
     if title:
         ax.set_title(title)
+    return fig
+
+
+def plot_cut_lines(
+    mesh: SurfaceMesh,
+    panel_ids: np.ndarray,
+    lines: Sequence[np.ndarray],
+    *,
+    title: str | None = None,
+) -> plt.Figure:
+    """3D view of a cut surface: every strip in its own colour, the cutting lines (node chains)
+    drawn over it."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    fig = plt.figure(figsize=(8, 6), layout="constrained")
+    ax = fig.add_subplot(projection="3d")
+    cells = np.vstack(list(mesh.cells.values()))
+    colours = plt.get_cmap("tab20")(np.mod(panel_ids, 20))
+    ax.add_collection3d(
+        Poly3DCollection(mesh.points[cells], facecolors=colours, edgecolors="none", alpha=0.9)
+    )
+    for chain in lines:
+        path = mesh.points[chain]
+        ax.plot(path[:, 0], path[:, 1], path[:, 2], color="black", linewidth=1.2)
+    low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    for axis, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), low, high, strict=True):
+        axis(a, b)
+    ax.set_box_aspect(np.maximum(high - low, 1e-3 * np.max(high - low)))  # true proportions
+    ax.view_init(elev=30, azim=-60)
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+def plot_nest(roll_width: float, length: float, pieces, *, units: str = "m") -> plt.Figure:
+    """The pieces on the roll (``vares.io.dxf.NestedDrawing``): cut lines filled, seam lines and
+    strip numbers; the roll's used length framed. A long roll is drawn in rows of at most 16
+    roll widths."""
+    rows = max(1, int(np.ceil(length / (16.0 * roll_width))))
+    piece_length = length / rows
+    fig, axes = plt.subplots(
+        rows,
+        1,
+        figsize=(12, 0.4 + rows * 12 * roll_width / piece_length),
+        layout="constrained",
+        squeeze=False,
+    )
+    for row, ax in enumerate(axes[:, 0]):
+        ax.add_patch(
+            plt.Rectangle((0, 0), length, roll_width, fill=False, edgecolor="grey", linewidth=1.0)
+        )
+        for number, piece in enumerate(pieces):
+            colour = plt.get_cmap("tab20")(number % 20)
+            ax.fill(piece.cut[:, 0], piece.cut[:, 1], color=colour, alpha=0.4, linewidth=0)
+            closed = np.vstack([piece.seam, piece.seam[:1]])
+            ax.plot(closed[:, 0], closed[:, 1], color="black", linewidth=0.5)
+            centre = piece.seam.mean(axis=0)
+            if row * piece_length <= centre[0] <= (row + 1) * piece_length:
+                label = piece.name.replace("strip-", "")
+                ax.text(*centre, label, ha="center", va="center", fontsize=7)
+        ax.set_xlim(row * piece_length - 0.005 * length, (row + 1) * piece_length + 0.005 * length)
+        ax.set_ylim(-0.05 * roll_width, 1.05 * roll_width)
+        ax.set_aspect("equal")
+        ax.set_ylabel(f"[{units}]")
+    axes[-1, 0].set_xlabel(f"along the roll [{units}]; width {roll_width:g}, length {length:.4g}")
     return fig

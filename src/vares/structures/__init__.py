@@ -1,17 +1,22 @@
-"""Whole structures: panels, the seams between them, and patterns whose seams match."""
+"""Whole structures: panels, the seams between them, patterns whose seams match, and a surface
+cut into strips of roll width and nested on the roll."""
 
+from .cutting import CutResult, cut
 from .matching import MatchingRecord, StructureResult, solve_structure
-from .options import StructureOptions
+from .options import CutOptions, StructureOptions
 from .panels import Panel, split_panels, width_across_warp
 from .seams import Seam, SeamReport, find_seams, seam_lengths, seam_marks, seam_reports
 
 __all__ = [
+    "CutOptions",
+    "CutResult",
     "MatchingRecord",
     "Panel",
     "Seam",
     "SeamReport",
     "StructureOptions",
     "StructureResult",
+    "cut",
     "find_seams",
     "seam_lengths",
     "seam_marks",

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
@@ -109,6 +109,7 @@ def solve_structure(
     *,
     seams: list[Seam] | None = None,
     prestress: float | Sequence[float] | None = None,
+    panel_settings: Sequence[Mapping[str, Any]] | None = None,
     options: SolveOptions | None = None,
     structure: StructureOptions | None = None,
     callback: Callable[[IterationRecord], None] | None = None,
@@ -121,6 +122,9 @@ def solve_structure(
     tolerance, iteration limit …); the seam matching uses the same tolerance and iteration limit,
     and holds each panel's rigid modes as its solve did. ``seams`` default to
     :func:`find_seams`; ``prestress`` is uniform (a number or warp, fill[, shear]).
+    ``panel_settings`` change solve options per panel (one mapping per panel, e.g.
+    ``{"warp_direction": (0, 1, 0)}`` to give every strip its own warp); each panel's result
+    keeps the options it was solved with.
     """
     options, structure = split_settings(
         settings, [options or SolveOptions(), structure or StructureOptions()]
@@ -128,9 +132,18 @@ def solve_structure(
     started = time.perf_counter()
     panels = list(panels)
     seams = find_seams(panels) if seams is None else seams
+    if panel_settings is not None and len(panel_settings) != len(panels):
+        raise ValueError(
+            f"panel_settings needs one mapping per panel ({len(panels)}); got {len(panel_settings)}"
+        )
+    own = (
+        [options.replace(**s) for s in panel_settings]
+        if panel_settings
+        else [options] * len(panels)
+    )
     results = [
-        solve(p.mesh, material, thickness, prestress=prestress, options=options, callback=callback)
-        for p in panels
+        solve(p.mesh, material, thickness, prestress=prestress, options=o, callback=callback)
+        for p, o in zip(panels, own, strict=True)
     ]
     independent = float(sum(r.energy for r in results))
     before = [seam_lengths([r.material_coordinates for r in results], s) for s in seams]

@@ -14,7 +14,15 @@ import numpy as np
 
 from .panels import Panel
 
-__all__ = ["Seam", "SeamReport", "find_seams", "seam_lengths", "seam_marks", "seam_reports"]
+__all__ = [
+    "Seam",
+    "SeamReport",
+    "find_seams",
+    "named_seam_marks",
+    "seam_lengths",
+    "seam_marks",
+    "seam_reports",
+]
 
 
 @dataclass(frozen=True)
@@ -147,8 +155,20 @@ def seam_marks(
 ) -> list[np.ndarray]:
     """Match mark points ``(k, 2)`` of every panel's pattern: every ``spacing`` (pattern units)
     along each seam, at the same arc lengths on both sides (so both patterns get the same marks)."""
-    marks: list[list[np.ndarray]] = [[] for _ in coordinates]
-    for seam in seams:
+    named = named_seam_marks(coordinates, seams, spacing)
+    return [
+        np.vstack([points for _, points in marks]) if marks else np.zeros((0, 2)) for marks in named
+    ]
+
+
+def named_seam_marks(
+    coordinates: list[np.ndarray], seams: list[Seam], spacing: float
+) -> list[list[tuple[int, np.ndarray]]]:
+    """Per panel, ``(seam index, mark points (k, 2))`` for every seam it has: the marks of
+    :func:`seam_marks`, each seam's on their own (mark ``j`` of a seam is at the same place of
+    the weld on both sides)."""
+    marks: list[list[tuple[int, np.ndarray]]] = [[] for _ in coordinates]
+    for number, seam in enumerate(seams):
         sides = [
             (seam.first, coordinates[seam.first][seam.nodes_first]),
             (seam.second, coordinates[seam.second][seam.nodes_second]),
@@ -162,5 +182,6 @@ def seam_marks(
                 np.searchsorted(cumulative, positions, side="right") - 1, 0, len(segment) - 1
             )
             fraction = ((positions - cumulative[index]) / segment[index])[:, None]
-            marks[panel].append(chain[index] + fraction * (chain[index + 1] - chain[index]))
-    return [np.vstack(m) if m else np.zeros((0, 2)) for m in marks]
+            points = chain[index] + fraction * (chain[index + 1] - chain[index])
+            marks[panel].append((number, points))
+    return marks

@@ -149,6 +149,28 @@ def _show_structure(outcome: JobOutcome) -> None:
     )
 
 
+def _show_cut(outcome: JobOutcome) -> None:
+    result, units = outcome.cut, outcome.units
+    plan = result.plan
+    lines = (
+        f"between {len(plan.lines)} drawn curves"
+        if result.options.seams == "curves"
+        else f"of {result.options.seams} lines ({plan.evaluations} layouts tried)"
+    )
+    console.print(
+        f"cut: {len(plan.panels)} strips {lines}, widest {max(result.widths):.4g} {units} with "
+        f"allowances (roll {result.options.roll_width:g}); worst cell angle "
+        f"{plan.cut.worst_angle:.1f}° (surface {result.surface_worst_angle:.1f}°); area 3D "
+        f"{result.panel_area:.6g} of {result.surface_area:.6g} {units}²"
+    )
+    if result.nest is not None:
+        nest = result.nest
+        console.print(
+            f"nest: {nest.length:.4g} {units} of roll, yield {100 * nest.yield_:.1f} % "
+            f"(waste {100 * nest.waste:.1f} %), {nest.elapsed:.1f} s"
+        )
+
+
 def show(outcome: JobOutcome) -> None:
     """Print what a job did: per pattern its status (and figures), the structure's seams, the
     warnings and the files."""
@@ -157,6 +179,8 @@ def show(outcome: JobOutcome) -> None:
         _show_panel(panel, detail=single)
     if not single:
         _show_structure(outcome)
+    if outcome.cut is not None:
+        _show_cut(outcome)
     warnings = outcome.panels[0].warnings if single else outcome.warnings
     if not single:
         warnings = warnings + [

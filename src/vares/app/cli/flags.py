@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Iterable
+from dataclasses import replace
 from enum import StrEnum
 from pathlib import Path
 from typing import Annotated, Any
@@ -17,7 +18,7 @@ import typer
 
 from ...options import Options, OptionsError, Spec
 from ...solver.options import SolveOptions
-from ...structures.options import StructureOptions
+from ...structures.options import CutOptions, StructureOptions
 from ..job import Job
 from ..sections import InputOptions, MaterialOptions, OutputOptions, PrestressOptions
 
@@ -41,6 +42,7 @@ PANELS = {
     "solver": "Solver",
     "output": "Output",
     "structure": "Structure",
+    "cut": "Cutting and nesting",
 }
 #: Kinds given on the command line as one comma-separated string.
 _TEXT_KINDS = {"vector", "plane", "floats", "strings", "paths"}
@@ -221,9 +223,43 @@ JOB_FLAGS = (
 )
 
 
-def job_from_flags(values: dict[str, Any], *, structure: bool = False, **source: Any) -> Job:
+#: The composite flag of the cutting lines (it sets ``seams`` and ``curves``).
+SEAMS_FLAG = [
+    option_parameter(
+        "seams",
+        None,
+        str | None,
+        "--seams",
+        help="Cutting lines: geodesic (default), planar, or a FILE of curves (polylines as "
+        "'x y z' lines, or a 3dm file; see --curves-layer).",
+        panel=PANELS["cut"],
+    )
+]
+
+
+def _seams(values: dict[str, Any]) -> dict[str, Any]:
+    given = values.get("seams")
+    if given is None:
+        return {}
+    if given.lower() in ("geodesic", "planar"):
+        return {"seams": given.lower()}
+    path = Path(given)
+    if not path.is_file():
+        raise InputError(f"--seams: expected geodesic, planar or a curves file; no file {given!r}")
+    return {"seams": "curves", "curves": str(path.resolve())}
+
+
+def job_from_flags(
+    values: dict[str, Any], *, structure: bool = False, cut: bool = False, **source: Any
+) -> Job:
     """The job the command line describes; ``source`` are the input's settings (mesh, meshes or
-    example, and the like) and paths on the command line are relative to the current folder."""
+    example, and the like) and paths on the command line are relative to the current folder.
+    ``cut`` makes a cut job (and a structure)."""
+    if cut:
+        return replace(
+            job_from_flags(values, structure=True, **source),
+            cut=build(CutOptions, values, **_seams(values)),
+        )
     return Job(
         input=build(InputOptions, values, **source),
         material=build(MaterialOptions, values),

@@ -1,0 +1,289 @@
+"""From one design surface to the roll: cutting lines, strips, patterns with matched seams, nest.
+
+:func:`cut` divides a surface into strips that fit the roll (:mod:`.layout`), patterns them as a
+structure with matched seams and the warp along each strip (:func:`.solve_structure`), draws each
+pattern's cut line with the allowance of each edge's kind (seam, free edge, cable pocket, clamp
+edge), checks the patterns' widths against the roll (and plans again with a narrower target if
+one is too wide), and nests the pieces on the roll (:mod:`.nesting`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..geometry.cutting import CutMesh
+from ..geometry.line_families import boundary_loops_3d
+from ..geometry.mesh import SurfaceMesh
+from ..geometry.outline import allowance_outline
+from ..geometry.surface_lines import min_angles, triangulated
+from ..units import unit_factor
+from ..materials import Hyperelastic
+from ..options import split_settings, takes_options
+from ..solver import IterationRecord, SolveOptions
+from .layout import StripPlan, plan_strips, strips_along_lines, width_across
+from .matching import StructureResult, solve_structure
+from .nesting import RollNest, nest_pieces
+from .options import CutOptions, StructureOptions
+
+__all__ = ["CutResult", "PieceOutline", "SeamLine", "cut"]
+
+#: Plans tried at most (each narrower than the last) until every pattern fits the roll.
+MAX_ROUNDS = 3
+
+
+@dataclass(frozen=True)
+class PieceOutline:
+    """A pattern's outline: the seam ring ``(k, 2)`` (counter-clockwise, pattern coordinates),
+    the kind of each of its edges (``"seam"`` or an edge type) and the cut ring ``(m, 2)``."""
+
+    seam: np.ndarray
+    edges: tuple[str, ...]
+    cut: np.ndarray
+
+    @property
+    def area(self) -> float:
+        x, y = self.seam[:, 0], self.seam[:, 1]
+        return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+@dataclass(frozen=True)
+class SeamLine:
+    """A seam of the cut surface: its two panels, its 3D length, the length of the cutting line
+    it follows (as computed, before the cut, between the points nearest to the seam's ends) and
+    its pattern length on each side."""
+
+    panels: tuple[str, str]
+    length_3d: float
+    line_length: float
+    length_2d: tuple[float, float]
+
+
+@dataclass
+class CutResult:
+    """What :func:`cut` produced: the strips (``plan``), their patterns (``structure``), the
+    outlines and widths across the warp with allowances (mesh units), the seams and the nest
+    (``None`` if the structure did not converge). ``rounds`` lists the widest pattern of every
+    plan tried; ``surface_worst_angle`` is the smallest cell angle (degrees) of the surface
+    before cutting (quads split into triangles), to compare with ``plan.cut.worst_angle``."""
+
+    plan: StripPlan
+    structure: StructureResult
+    outlines: list[PieceOutline]
+    widths: list[float]
+    seams: list[SeamLine]
+    nest: RollNest | None
+    options: CutOptions
+    surface_area: float
+    units: str = "m"
+    dxf_units: str = "mm"
+    allowance: float = 0.0
+    rounds: list[float] = field(default_factory=list)
+    elapsed: float = 0.0
+    surface_worst_angle: float = 0.0
+
+    @property
+    def converged(self) -> bool:
+        return self.structure.converged
+
+    @property
+    def panel_area(self) -> float:
+        """Total 3D area of the panels."""
+        return float(sum(p.mesh.area for p in self.plan.panels))
+
+
+@takes_options(SolveOptions, StructureOptions, CutOptions)
+def cut(
+    mesh: SurfaceMesh,
+    material: Hyperelastic,
+    thickness: float = 1.0,
+    *,
+    prestress: float | Sequence[float] | None = None,
+    curves: Sequence[np.ndarray] | None = None,
+    allowance: float = 0.0,
+    units: str = "m",
+    dxf_units: str = "mm",
+    options: SolveOptions | None = None,
+    structure: StructureOptions | None = None,
+    cutting: CutOptions | None = None,
+    callback: Callable[[IterationRecord], None] | None = None,
+    before_solve: Callable[[StripPlan], None] | None = None,
+    **settings: Any,
+) -> CutResult:
+    """Cut a surface into strips of roll width, pattern them with matched seams and nest them.
+
+    ``roll_width`` (an option, below) is in the mesh's ``units``; ``allowance`` (the seam
+    allowance) and the edge allowances are in ``dxf_units``, as on the cutter's drawing.
+    ``curves`` are the user's cutting lines (polylines ``(k, 3)`` near the surface) when
+    ``seams = "curves"``. The warp runs along each strip unless ``warp_direction`` is given;
+    ``before_solve`` is told every plan before its patterns are computed.
+    """
+    mine = {k: settings.pop(k) for k in list(settings) if k in CutOptions.specs()}
+    cutting = cutting.replace(**mine) if cutting is not None else CutOptions(**mine)
+    options, structure = split_settings(
+        settings, [options or SolveOptions(), structure or StructureOptions()]
+    )
+    started = time.perf_counter()
+    scale = unit_factor(dxf_units, units)
+    allowances = {
+        kind: scale * cutting.allowance(kind, allowance)
+        for kind in ("seam", "free", "cable", "clamp")
+    }
+    surface = triangulated(mesh)
+    target, rounds = cutting.roll_width, []
+    for _ in range(MAX_ROUNDS):
+        plan = _plan(surface, target, cutting, allowances, options, curves)
+        if before_solve is not None:
+            before_solve(plan)
+        own = [
+            {} if options.warp_direction is not None else {"warp_direction": tuple(w)}
+            for w in plan.warps
+        ]
+        result = solve_structure(
+            plan.panels,
+            material,
+            thickness,
+            prestress=prestress,
+            panel_settings=own,
+            options=options,
+            structure=structure,
+            callback=callback,
+        )
+        outlines = piece_outlines(plan.cut, result, cutting, allowances)
+        widths = [
+            width_across(o.cut, r.fibres.warp)
+            for o, r in zip(outlines, result.results, strict=True)
+        ]
+        rounds.append(max(widths))
+        if not result.converged or max(widths) <= cutting.roll_width or curves is not None:
+            break
+        # the flattened widths underestimated the patterns': ask the flattening for less
+        target = max(plan.widths) * cutting.roll_width / max(widths) * (1.0 - 1e-3)
+    nest = None
+    if result.converged and max(widths) <= cutting.roll_width:
+        nest = nest_pieces(
+            [o.cut for o in outlines],
+            cutting.roll_width,
+            net_areas=[o.area for o in outlines],
+            allow_turn=cutting.allow_turn,
+            gap=scale * cutting.piece_gap,
+            time_limit=cutting.nest_time,
+            seed=cutting.nest_seed,
+        )
+    return CutResult(
+        plan,
+        result,
+        outlines,
+        widths,
+        seam_lines(plan, result),
+        nest,
+        cutting,
+        mesh.area,
+        units,
+        dxf_units,
+        allowance,
+        rounds,
+        time.perf_counter() - started,
+        float(min_angles(surface.points, surface.cells["triangle"]).min()),
+    )
+
+
+def _plan(surface, target, cutting: CutOptions, allowances, options, curves) -> StripPlan:
+    if cutting.seams == "curves":
+        from ..geometry.drawn_lines import curves_on_surface
+
+        base, lines = curves_on_surface(surface, curves or [], cutting.snap)
+        return strips_along_lines(base, lines, cutting.snap, options.warp_direction)
+    edge_kind = cutting.edge_type
+    return plan_strips(
+        surface,
+        target,
+        seams=cutting.seams,
+        layout=cutting.layout,
+        direction=cutting.strip_direction,
+        seam_allowance=allowances["seam"],
+        edge_allowance=allowances[edge_kind],
+        warp_direction=options.warp_direction,
+        snap=cutting.snap,
+    )
+
+
+def piece_outlines(
+    cut_mesh: CutMesh, structure: StructureResult, cutting: CutOptions, allowances: dict
+) -> list[PieceOutline]:
+    """Every panel's seam ring, the kind of each edge and its cut ring (allowances in mesh
+    units, by kind)."""
+    points = cut_mesh.mesh.points
+    n = len(points)
+    seam_keys = set((cut_mesh.seam_edges @ np.array([n, 1])).tolist())
+    loops = boundary_loops_3d(cut_mesh.mesh)
+    high = set()
+    if len(loops) > 1:
+        high = set(max(loops, key=lambda loop: points[loop, 2].mean()).tolist())
+    cells = cut_mesh.mesh.cells["triangle"]
+    outlines = []
+    for index, result in enumerate(structure.results):
+        used = np.unique(cells[cut_mesh.panel_ids == index])
+        ring_nodes = max(boundary_loops_3d(result.mesh), key=len)
+        global_nodes = used[ring_nodes]
+        kinds = []
+        for a, b in zip(global_nodes, np.roll(global_nodes, -1), strict=True):
+            if min(a, b) * n + max(a, b) in seam_keys:
+                kinds.append("seam")
+            elif a in high and b in high:
+                kinds.append(cutting.high_edge_type or cutting.edge_type)
+            else:
+                kinds.append(cutting.edge_type)
+        seam = result.material_coordinates[ring_nodes]
+        ring = allowance_outline(seam, [allowances[k] for k in kinds])
+        outlines.append(PieceOutline(seam, tuple(kinds), ring))
+    return outlines
+
+
+def _stretch(polyline: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
+    """Length of a polyline between the points nearest to ``start`` and ``end`` (the stretch of
+    a cutting line a seam follows: its ends may have been moved onto boundary nodes)."""
+    a, b = polyline[:-1], polyline[1:]
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    cumulative = np.concatenate([[0.0], np.cumsum(length)])
+
+    def position(point: np.ndarray) -> float:
+        t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.maximum(length**2, 1e-300), 0, 1)
+        k = int(np.argmin(np.linalg.norm(a + t[:, None] * d - point, axis=1)))
+        return float(cumulative[k] + t[k] * length[k])
+
+    return abs(position(end) - position(start))
+
+
+def seam_lines(plan: StripPlan, structure: StructureResult) -> list[SeamLine]:
+    """The seams with their 3D lengths, the lengths of the lines they follow and their
+    pattern lengths on both sides."""
+    from scipy.spatial import cKDTree
+
+    chains = [plan.cut.mesh.points[c] for c in plan.cut.lines]
+    owner = np.concatenate([np.full(len(c), k) for k, c in enumerate(chains)])
+    tree = cKDTree(np.vstack(chains)) if chains else None
+    out = []
+    for seam, report in zip(structure.seams, structure.seam_reports, strict=True):
+        nodes = structure.panels[seam.first].mesh.points[seam.nodes_first]
+        length_3d = float(np.linalg.norm(np.diff(nodes, axis=0), axis=1).sum())
+        line_length = float("nan")
+        if tree is not None:
+            _, found = tree.query(nodes)
+            line = int(np.bincount(owner[found]).argmax())
+            if line < len(plan.lines):
+                line_length = _stretch(plan.lines[line].points, nodes[0], nodes[-1])
+        out.append(
+            SeamLine(
+                (report.first, report.second),
+                length_3d,
+                line_length,
+                (report.length_first_after, report.length_second_after),
+            )
+        )
+    return out

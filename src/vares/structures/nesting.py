@@ -1,0 +1,163 @@
+"""Nesting the pieces on the roll: the shortest length of fabric that holds every cut outline.
+
+The roll runs along x, its usable width along y (``0 ≤ y ≤ roll width``); every piece keeps its
+warp along the roll (patterns come with the warp along +x) and may be turned by 180° when
+allowed. The layout is found by sparrow (Gardeyn & Wauters 2025, "An open-source heuristic to
+reboot 2D nesting research"), a maintained strip-packing heuristic in Rust, through its Python
+bindings ``spyrrow`` (MIT), which bundle it with its collision engine jagua-rs (MPL-2.0). The
+result is checked independently here with shapely: no two pieces overlap, every piece lies
+inside the roll.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["NestError", "NestedPiece", "RollNest", "nest_pieces"]
+
+#: Clearance the nesting search keeps between pieces and to the roll's edges, relative to the
+#: roll width (the search works in single precision; the clearance makes the result exact).
+_CLEARANCE = 2e-5
+
+
+class NestError(RuntimeError):
+    """The nesting gave pieces that overlap or leave the roll (it never should)."""
+
+
+@dataclass(frozen=True)
+class NestedPiece:
+    """Where a piece lies on the roll: turned by ``rotation`` degrees (0 or 180) about the
+    origin of its own coordinates, then moved by ``translation`` ``(2,)``."""
+
+    index: int
+    rotation: float
+    translation: np.ndarray
+
+    def place(self, points: np.ndarray) -> np.ndarray:
+        """Points ``(n, 2)`` of the piece as laid on the roll."""
+        angle = np.radians(self.rotation)
+        c, s = np.cos(angle), np.sin(angle)
+        return np.asarray(points) @ np.array([[c, s], [-s, c]]) + self.translation
+
+
+@dataclass(frozen=True)
+class RollNest:
+    """Pieces on one roll: their placements, the length of roll used (from x = 0 to the end of
+    the last piece), the net area (the patterns inside their seam lines) and the yield, net area
+    / (roll width × length)."""
+
+    roll_width: float
+    length: float
+    pieces: list[NestedPiece]
+    net_area: float
+    elapsed: float
+
+    @property
+    def yield_(self) -> float:
+        return self.net_area / (self.roll_width * self.length)
+
+    @property
+    def waste(self) -> float:
+        """Fraction of the roll used that is cut away: 1 − yield."""
+        return 1.0 - self.yield_
+
+
+def nest_pieces(
+    outlines: Sequence[np.ndarray],
+    roll_width: float,
+    *,
+    net_areas: Sequence[float],
+    allow_turn: bool = True,
+    gap: float = 0.0,
+    time_limit: float = 10.0,
+    seed: int = 0,
+) -> RollNest:
+    """Lay the cut outlines ``(k_i, 2)`` (warp along +x) on a roll of ``roll_width`` (module
+    docs), ``gap`` apart, searching for ``time_limit`` seconds (at least one)."""
+    import spyrrow
+    from shapely.geometry import Polygon
+
+    started = time.perf_counter()
+    clearance = _CLEARANCE * roll_width
+    shapes = [np.asarray(o, dtype=float) for o in outlines]
+    for index, shape in enumerate(shapes):
+        if np.ptp(shape[:, 1]) > roll_width - 2 * clearance:
+            raise ValueError(
+                f"piece {index + 1} is {np.ptp(shape[:, 1]):.4g} wide across the warp, more "
+                f"than the roll width {roll_width:g}"
+            )
+    offsets = [shape.min(axis=0) for shape in shapes]  # sparrow likes pieces near the origin
+    items = [
+        spyrrow.Item(
+            str(index),
+            _search_shape(shape - offset, clearance),
+            demand=1,
+            allowed_orientations=[0.0, 180.0] if allow_turn else [0.0],
+        )
+        for index, (shape, offset) in enumerate(zip(shapes, offsets, strict=True))
+    ]
+    instance = spyrrow.StripPackingInstance(
+        "roll", strip_height=roll_width - 2 * clearance, items=items
+    )
+    config = spyrrow.StripPackingConfig(
+        early_termination=True,
+        total_computation_time=max(1, round(time_limit)),
+        min_items_separation=gap + clearance,
+        num_workers=1,
+        seed=seed,
+    )
+    try:
+        solution = instance.solve(config)
+    except BaseException as exc:  # a panic in the Rust code arrives as a BaseException
+        if isinstance(exc, KeyboardInterrupt | SystemExit):
+            raise
+        raise NestError(f"the nesting search failed: {exc}") from None
+    pieces = []
+    for placed in solution.placed_items:
+        index = int(placed.id)
+        rotation = float(np.round(placed.rotation)) % 360.0
+        moved = NestedPiece(index, rotation, np.zeros(2))
+        turned_offset = moved.place(-offsets[index][None])[0]
+        translation = np.array(placed.translation, dtype=float) + turned_offset
+        pieces.append(NestedPiece(index, rotation, translation + np.array([0.0, clearance])))
+    pieces.sort(key=lambda p: p.index)
+    placed_shapes = [Polygon(p.place(shapes[p.index])) for p in pieces]
+    start = min(s.bounds[0] for s in placed_shapes)
+    pieces = [NestedPiece(p.index, p.rotation, p.translation - [start, 0.0]) for p in pieces]
+    placed_shapes = [Polygon(p.place(shapes[p.index])) for p in pieces]
+    check_nest(placed_shapes, roll_width)
+    length = max(s.bounds[2] for s in placed_shapes)
+    return RollNest(
+        roll_width, length, pieces, float(sum(net_areas)), time.perf_counter() - started
+    )
+
+
+def _search_shape(shape: np.ndarray, clearance: float) -> list[tuple[float, float]]:
+    """The outline the search works with: grown by half the clearance and simplified within a
+    quarter of it (so it still covers the piece), without repeated or nearly repeated points."""
+    from shapely.geometry import Polygon
+
+    grown = Polygon(shape).buffer(0.5 * clearance, join_style="mitre").simplify(0.25 * clearance)
+    if grown.geom_type != "Polygon":
+        grown = max(grown.geoms, key=lambda g: g.area)
+    return [tuple(p) for p in np.asarray(grown.exterior.coords)[:-1]]
+
+
+def check_nest(shapes: Sequence, roll_width: float) -> None:
+    """Raise :class:`NestError` if two shapely polygons overlap or touch, or one leaves the roll
+    (``0 ≤ y ≤ roll_width``, ``x ≥ 0``)."""
+    from shapely.strtree import STRtree
+
+    for index, shape in enumerate(shapes):
+        low_x, low_y, _, high_y = shape.bounds
+        if low_y < 0 or high_y > roll_width or low_x < 0:
+            raise NestError(f"nested piece {index + 1} leaves the roll ({shape.bounds})")
+    tree = STRtree(list(shapes))
+    for index, shape in enumerate(shapes):
+        for other in tree.query(shape, predicate="intersects"):
+            if other != index:
+                raise NestError(f"nested pieces {index + 1} and {int(other) + 1} overlap")

@@ -1,0 +1,122 @@
+"""``vares cut`` and ``vares.cut``: a surface to strips, patterns with matched seams and a nest."""
+
+import itertools
+import json
+
+import ezdxf
+import meshio
+import numpy as np
+import pytest
+from shapely.geometry import Polygon
+from typer.testing import CliRunner
+
+import vares
+from vares.app.cli import app
+from vares.geometry.examples import saddle, tent_roof
+
+runner = CliRunner()
+FABRIC = vares.materials.fabric("pes-pvc-type-2").material()
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def error_line(result):
+    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
+@pytest.fixture(scope="module")
+def small_saddle_file(tmp_path_factory):
+    mesh = saddle(size=8.0, height=1.6, n=12)
+    path = tmp_path_factory.mktemp("input") / "saddle.obj"
+    meshio.write(path, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    return path, mesh
+
+
+def test_cut_command_writes_the_plan_the_patterns_and_the_nest(tmp_path, small_saddle_file):
+    source, mesh = small_saddle_file
+    out = tmp_path / "cut"
+    job = tmp_path / "cut.toml"
+    result = run(
+        "cut", source, "--roll-width", 1.8, "-o", out, "--fabric", "pes-pvc-type-2",
+        "--prestress", "2,1.5", "--allowance", 20, "--edge-type", "cable",
+        "--cable-allowance", 60, "--nest-time", 1, "--mark-spacing", 1000, "-q",
+        "--save-job", job,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "cut.json").read_text())
+    assert set(data) == {"roll_width", "panels", "seams", "nesting"}
+    assert data["roll_width"] == 1.8
+    panels, seams, nesting = data["panels"], data["seams"], data["nesting"]
+    assert len(panels) >= 2 and len(seams) == len(panels) - 1
+    for panel in panels:
+        assert set(panel) == {"name", "area", "width", "warp"}
+        assert panel["width"] <= 1.8
+    assert sum(p["area"] for p in panels) == pytest.approx(mesh.area, rel=1e-12)
+    for seam in seams:
+        assert set(seam) == {"panels", "length_3d", "length_2d"}
+        a, b = seam["length_2d"]
+        assert abs(a - b) <= 1e-9 * a
+    assert set(nesting) == {"roll_width", "length", "yield"} and 0 < nesting["yield"] < 1
+    details = json.loads((out / "structure.json").read_text())["cutting"]
+    assert details["surface_area"] == pytest.approx(details["panels_area"], rel=1e-12)
+    for line in details["seam_lines"]:
+        assert abs(line["excess"]) < 0.01  # each seam within 1 % of its geodesic
+    drawing = ezdxf.readfile(out / "nest.dxf")
+    space = drawing.modelspace()
+    seams_drawn = [e for e in space.query("LWPOLYLINE") if e.dxf.layer == "SEAM"]
+    assert len(seams_drawn) == len(panels)
+    cut_lines = [
+        Polygon(np.array(e.get_points("xy"))) for e in space.query("LWPOLYLINE[layer=='CUT']")
+    ]
+    for a, b in itertools.combinations(cut_lines, 2):
+        assert not a.intersects(b)  # no overlap on the roll (mm)
+    assert max(p.bounds[3] for p in cut_lines) <= 1800 and min(p.bounds[1] for p in cut_lines) >= 0
+    names = {e.dxf.text for e in space.query("TEXT[layer=='MARKS']")}
+    assert names and all(n.startswith("S") for n in names)
+    panel_ids = meshio.read(out / "panels.vtu").cell_data["panel"][0]
+    assert len(np.unique(panel_ids)) == len(panels)
+    for name in ("cut_lines.png", "nest.png", "nest.svg", "strip-1/pattern.dxf"):
+        assert (out / name).is_file()
+    again = run("run", job, "-o", tmp_path / "again", "-q")
+    assert again.exit_code == 0, again.stderr
+    rerun = json.loads((tmp_path / "again" / "cut.json").read_text())
+    assert [p["width"] for p in rerun["panels"]] == [p["width"] for p in panels]
+
+
+def test_cut_command_errors(tmp_path, small_saddle_file):
+    source, _ = small_saddle_file
+    missing = run("cut", source, "-o", tmp_path / "a")
+    assert missing.exit_code == 2 and "roll-width" in error_line(missing)
+    bad = run("cut", source, "--roll-width", 2, "--seams", "spline", "-o", tmp_path / "b")
+    assert bad.exit_code == 2 and "--seams" in error_line(bad)
+    narrow = run("cut", source, "--roll-width", 0.01, "-o", tmp_path / "c", "-q")
+    assert narrow.exit_code == 2 and "strips" in error_line(narrow)
+    pattern = run("pattern", source, "-o", tmp_path / "d")
+    assert pattern.exit_code == 0 or "error" in pattern.stderr
+    example = run("example", "conic-tent", "-o", tmp_path / "e")
+    assert example.exit_code == 2 and "vares cut" in error_line(example)
+
+
+def test_radial_strips_of_a_tent_with_their_own_warps():
+    mesh = tent_roof(outer_radius=4.0, ring_radius=0.8, height=2.5, n_radial=10, n_around=12)
+    result = vares.cut(
+        mesh, FABRIC, prestress=(2.0, 1.5), roll_width=2.0, nest_time=1, allowance=20.0,
+        high_edge_type="clamp", clamp_allowance=50.0,
+    )  # fmt: skip
+    assert result.converged, result.structure.reason
+    assert result.plan.family.kind == "radial" and result.plan.family.closed
+    assert max(result.widths) <= 2.0
+    assert result.panel_area == pytest.approx(mesh.area, rel=1e-12)
+    warps = np.array(result.plan.warps)
+    angles = np.degrees(np.arctan2(warps[:, 1], warps[:, 0]))
+    assert len(np.unique(np.round(angles))) == len(warps)  # every strip its own warp
+    for seam in result.seams:  # meridians: geodesics and plane sections alike
+        assert abs(seam.length_3d / seam.line_length - 1) < 0.01
+        assert abs(seam.length_2d[0] - seam.length_2d[1]) < 1e-9 * seam.length_2d[0]
+    kinds = set(itertools.chain.from_iterable(o.edges for o in result.outlines))
+    assert kinds == {"seam", "free", "clamp"}
+    assert result.nest is not None and result.nest.length > 0

@@ -1,0 +1,185 @@
+"""Cutting lines (geodesics, plane sections, drawn curves), cutting a mesh along them, strips of
+roll width, cut outlines with allowances per edge and nesting on the roll."""
+
+import itertools
+
+import numpy as np
+import pytest
+from shapely.geometry import Polygon
+
+from vares.geometry.cutting import cut_mesh
+from vares.geometry.drawn_lines import closest_points, curves_on_surface
+from vares.geometry.examples import cone_segment, cylinder160, hypar, saddle
+from vares.geometry.line_families import geodesic_between_ends, line_family
+from vares.geometry.outline import allowance_outline
+from vares.geometry.surface_lines import CuttingError, geodesic_lines, plane_sections
+from vares.structures import find_seams, split_panels
+from vares.structures.layout import plan_strips
+from vares.structures.nesting import nest_pieces
+
+
+def developed(line, flat: np.ndarray) -> np.ndarray:
+    """The line's points in a development ``flat`` (n, 2) of the mesh (affine in every cell)."""
+    a, b = flat[line.ends[:, 0]], flat[line.ends[:, 1]]
+    return (1 - line.fractions)[:, None] * a + line.fractions[:, None] * b
+
+
+def distance_to_segment(points, a, b):
+    t = np.clip((points - a) @ (b - a) / ((b - a) @ (b - a)), 0, 1)
+    return np.linalg.norm(a + t[:, None] * (b - a) - points, axis=1)
+
+
+def test_cylinder_geodesics_unroll_to_straight_lines():
+    """The triangulated cylinder is developable (its cells are halves of plane rectangles): a
+    helix-like geodesic unrolls onto the straight segment between its ends, a generator is one."""
+    n_around, n_along, radius, angle = 32, 16, 1.0, 160.0
+    mesh = cylinder160(radius, 2.0, angle, n_around, n_along)
+    chord = 2 * radius * np.sin(np.radians(angle) / (2 * n_around))
+    i, j = np.meshgrid(np.arange(n_around + 1), np.arange(n_along + 1), indexing="xy")
+    flat = np.column_stack([chord * i.ravel(), 2.0 / n_along * j.ravel()])
+    start, end = 1 * (n_around + 1) + 2, 15 * (n_around + 1) + 29  # helix-like
+    along = 0 * (n_around + 1) + 10, 16 * (n_around + 1) + 10  # generator
+    helix, generator = geodesic_lines(mesh, [(start, end), along])
+    path = developed(helix, flat)
+    exact = np.linalg.norm(flat[end] - flat[start])
+    # the edge-flip solver lays its path out cell by cell: straight to ~1e-7 of its length
+    assert distance_to_segment(path, flat[start], flat[end]).max() < 1e-6 * exact
+    assert helix.length == pytest.approx(exact, rel=1e-12)
+    assert len(helix.points) > 20  # it crosses cells, it does not follow edges
+    smooth = np.hypot(radius * np.radians(27 * angle / n_around), 28 / 16)  # the smooth helix
+    assert abs(helix.length / smooth - 1) < 1e-3
+    assert generator.length == pytest.approx(2.0, rel=1e-12)
+    np.testing.assert_allclose(generator.points[:, 0], mesh.points[along[0], 0], atol=1e-12)
+
+
+def test_cone_geodesic_unrolls_to_a_straight_line():
+    n_radial, n_around = 12, 24
+    mesh = cone_segment(60.0, 120.0, 1.0, 4.0, n_radial, n_around)
+    rays = mesh.points.reshape(n_around + 1, n_radial + 1, 3)[:, -1]
+    rays = rays / np.linalg.norm(rays, axis=1)[:, None]
+    turns = np.arccos(np.clip(np.sum(rays[1:] * rays[:-1], axis=1), -1, 1))
+    alpha = np.concatenate([[0.0], np.cumsum(turns)])  # the development of the polyhedral cone
+    slant = np.linspace(1.0, 4.0, n_radial + 1)
+    s, a = np.meshgrid(slant, alpha, indexing="xy")
+    flat = np.column_stack([(s * np.cos(a)).ravel(), (s * np.sin(a)).ravel()])
+    start, end = 0 * (n_radial + 1) + 12, 20 * (n_radial + 1) + 3
+    assert distance_to_segment(np.zeros((1, 2)), flat[start], flat[end])[0] > 1.0  # stays on
+    (line,) = geodesic_lines(mesh, [(start, end)])
+    exact = np.linalg.norm(flat[end] - flat[start])
+    assert distance_to_segment(developed(line, flat), flat[start], flat[end]).max() < 1e-6 * exact
+    assert line.length == pytest.approx(exact, rel=1e-12)
+
+
+def test_plane_sections_lie_in_their_plane_and_cross_the_surface():
+    mesh = hypar(size=10.0, rise=0.06, n=12)
+    (line,) = plane_sections(mesh, (0.3, 1.0, 0.0), 1.7)
+    np.testing.assert_allclose(line.points @ np.array([0.3, 1.0, 0.0]), 1.7, atol=1e-12)
+    boundary = set(np.unique(mesh.boundary_edges()).tolist())
+    for k in (0, -1):  # from boundary to boundary
+        assert set(line.ends[k].tolist()) <= boundary
+
+
+@pytest.mark.parametrize("kind", ["geodesic", "planar"])
+def test_cutting_along_lines_keeps_the_surface(kind):
+    mesh = saddle(size=10.0, height=2.0, n=12)
+    family = line_family(mesh, "parallel", (1.0, 1.0, 0.0))
+    sections = [family.sections(mesh, s)[0] for s in (-3.0, -0.4, 2.5)]
+    base, lines = (
+        (mesh, sections) if kind == "planar" else geodesic_between_ends(mesh, sections, 0.05)
+    )
+    cut = cut_mesh(base, lines)
+    assert cut.num_panels == 4
+    assert cut.mesh.area == pytest.approx(mesh.area, rel=1e-12)
+    _, _, distance = closest_points(mesh, cut.mesh.points)  # every node on the surface
+    assert distance.max() < 1e-12
+    panels = split_panels(cut.mesh, cut.panel_ids)
+    assert sum(p.mesh.area for p in panels) == pytest.approx(mesh.area, rel=1e-12)
+    seams = find_seams(panels)
+    assert len(seams) == 3
+    for seam, chain, line in zip(
+        sorted(
+            seams,
+            key=lambda s: panels[s.first].mesh.points[s.nodes_first].mean(axis=0) @ family.across,
+        ),
+        sorted(cut.lines, key=lambda c: cut.mesh.points[c].mean(axis=0) @ family.across),
+        sorted(lines, key=lambda li: li.points.mean(axis=0) @ family.across),
+        strict=True,
+    ):
+        first = panels[seam.first].mesh.points[seam.nodes_first]
+        np.testing.assert_allclose(first, panels[seam.second].mesh.points[seam.nodes_second])
+        length = np.linalg.norm(np.diff(first, axis=0), axis=1).sum()
+        assert length == pytest.approx(
+            np.linalg.norm(np.diff(cut.mesh.points[chain], axis=0), axis=1).sum()
+        )
+        assert abs(length / line.length - 1) < 0.01  # the seam follows its line
+    assert cut.worst_angle > 1.0
+
+
+def test_crossing_lines_are_refused():
+    mesh = hypar(size=10.0, rise=0.06, n=8)
+    lines = plane_sections(mesh, (1, 0, 0), 0.3) + plane_sections(mesh, (0, 1, 0), 0.2)
+    with pytest.raises(CuttingError, match=r"cross|meet"):
+        cut_mesh(mesh, lines)
+
+
+def test_drawn_curves_become_cutting_lines_through_their_points():
+    mesh = hypar(size=10.0, rise=0.06, n=12)
+    x = np.linspace(-5.0, 5.0, 9)
+    across = [y + 0.3 * np.sin(x) for y in (-2.0, 1.5)]
+    curves = [np.column_stack([x, y, 0.06 * x * y + 0.02]) for y in across]  # 2 cm above
+    base, lines = curves_on_surface(mesh, curves, 0.05)
+    cut = cut_mesh(base, lines)
+    assert cut.num_panels == 3
+    assert cut.mesh.area == pytest.approx(mesh.area, rel=1e-12)
+    cell = 10.0 / 12
+    for curve, line in zip(curves, lines, strict=True):
+        # the line passes through the drawn points (on the surface, moved onto an edge if within
+        # 5 % of a cell of it; one point per cell)
+        distance = np.linalg.norm(curve[:, None, :] - line.points[None, :, :], axis=2).min(axis=1)
+        assert np.median(distance) < 0.03 + 0.05 * cell and distance.max() < cell
+
+
+def test_strips_fit_the_roll_with_the_least_number():
+    mesh = saddle(size=10.0, height=2.0, n=16)
+    plan = plan_strips(mesh, 2.0, seam_allowance=0.02, edge_allowance=0.05, direction=(0, 1, 0))
+    assert max(plan.widths) <= 2.0
+    count = len(plan.panels)
+    tried = dict(plan.history)
+    assert count - 1 in tried and tried[count - 1] > 2.0  # one strip fewer does not fit
+    assert sum(p.mesh.area for p in plan.panels) == pytest.approx(mesh.area, rel=1e-12)
+
+
+def test_allowance_outline_per_edge():
+    square = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 2.0]])
+    outline = allowance_outline(square, [0.1, 0.2, 0.3, 0.4])  # bottom, right, top, left
+    low, high = outline.min(axis=0), outline.max(axis=0)
+    np.testing.assert_allclose([*low, *high], [-0.4, -0.1, 4.2, 2.3], atol=1e-12)
+    assert Polygon(outline).area == pytest.approx(4.6 * 2.4, rel=1e-12)
+    hexagon = np.column_stack([np.cos(np.arange(6) * np.pi / 3), np.sin(np.arange(6) * np.pi / 3)])
+    buffered = Polygon(hexagon).buffer(0.05, join_style="mitre", mitre_limit=4.0)
+    assert Polygon(allowance_outline(hexagon, 0.05)).symmetric_difference(buffered).area < 1e-12
+
+
+@pytest.mark.parametrize("turn", [True, False])
+def test_nesting_never_overlaps_and_stays_on_the_roll(turn):
+    rng = np.random.default_rng(3)
+    pieces, areas = [], []
+    for _ in range(7):
+        length, wide, narrow = rng.uniform(3, 8), rng.uniform(0.8, 1.4), rng.uniform(0.2, 0.6)
+        shape = np.array(
+            [[0, 0], [length, 0.5 * (wide - narrow)], [length, 0.5 * (wide + narrow)], [0, wide]]
+        )
+        pieces.append(shape + rng.uniform(-5, 5, 2))
+        areas.append(Polygon(shape).area)
+    nest = nest_pieces(pieces, 2.5, net_areas=areas, allow_turn=turn, time_limit=1, seed=1)
+    placed = [Polygon(p.place(pieces[p.index])) for p in nest.pieces]
+    assert sorted(p.index for p in nest.pieces) == list(range(7))
+    for a, b in itertools.combinations(placed, 2):
+        assert not a.intersects(b)
+    bounds = np.array([p.bounds for p in placed])
+    assert bounds[:, 1].min() >= 0 and bounds[:, 3].max() <= 2.5 and bounds[:, 0].min() >= 0
+    assert nest.length == pytest.approx(bounds[:, 2].max())
+    assert nest.yield_ == pytest.approx(sum(areas) / (2.5 * nest.length))
+    assert 0 < nest.yield_ <= 1
+    if not turn:
+        assert all(p.rotation == 0 for p in nest.pieces)
