@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import unit_factor
 from ..io.dxf import NestedDrawing, write_nest_dxf
 from ..io.files import atomic_path, write_json
 from ..io.meshes import write_surface
 from ..structures.seams import named_seam_marks
+from ..units import unit_factor
 from .outcome import JobOutcome
 from .sections import STRUCTURE_MARK_SPACING
 
@@ -180,7 +180,7 @@ def _lines_figure(outcome: JobOutcome):
     plan = outcome.cut.plan
     title = (
         f"{len(plan.panels)} strips, {outcome.cut.options.seams} cutting lines, roll width "
-        f"{outcome.cut.options.roll_width:g} {outcome.outcome.units}"
+        f"{outcome.cut.options.roll_width:g} {outcome.units}"
     )
     return plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines, title=title)
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -124,6 +125,7 @@ class SurfaceMesh:
         self._points = points
         self._cells = clean
         self._node_map = node_map
+        self._edges: _EdgeTable | None = None
         for arr in (self._points, self._node_map, *self._cells.values()):
             arr.setflags(write=False)
         self._validate()
@@ -163,8 +165,8 @@ class SurfaceMesh:
 
     def boundary_edges(self) -> np.ndarray:
         """Boundary edges ``(k, 2)``, each oriented as in its cell."""
-        edges, _, counts = self._edge_table()
-        return edges[counts == 1]
+        table = self._edge_table()
+        return table.directed[table.counts[table.edge_id] == 1]
 
     def boundary_loops(self) -> list[np.ndarray]:
         """Closed node loops of the boundary, longest (most nodes) first, each in cell
@@ -219,13 +221,11 @@ class SurfaceMesh:
                 owner.append(offset + np.arange(len(a)))
         return np.vstack(edges), np.concatenate(owner)
 
-    def _edge_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Directed edges, the undirected edge id of each, and the number of cells per id."""
-        directed, _ = self._directed_edges()
-        key = np.sort(directed, axis=1)
-        _, edge_id, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-        edge_id = edge_id.ravel()
-        return directed, edge_id, counts[edge_id]
+    def _edge_table(self) -> _EdgeTable:
+        """The edge table (computed once: the mesh does not change)."""
+        if self._edges is None:
+            self._edges = _EdgeTable.of(self._directed_edges(), self.num_points)
+        return self._edges
 
     def _validate(self) -> None:
         points = self._points
@@ -244,26 +244,21 @@ class SurfaceMesh:
                     "or collinear corners"
                 )
 
-        directed, owner = self._directed_edges()
-        key = np.sort(directed, axis=1)
-        _, edge_id, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-        edge_id = edge_id.ravel()
+        table = self._edge_table()
+        directed, owner, edge_id, counts = table.directed, table.owner, table.edge_id, table.counts
 
         over = np.flatnonzero(counts > 2)
         if over.size:
-            e = key[np.flatnonzero(np.isin(edge_id, over))]
-            cells_at = owner[np.isin(edge_id, over)]
+            at = np.isin(edge_id, over)
+            edge = np.sort(directed[np.flatnonzero(at)[0]])
             raise MeshError(
-                f"non-manifold edges: edge {tuple(int(v) for v in self._node_map[e[0]])} is "
+                f"non-manifold edges: edge {tuple(int(v) for v in self._node_map[edge])} is "
                 "shared by more "
-                f"than two cells ({self._describe_cells(np.unique(cells_at))})"
+                f"than two cells ({self._describe_cells(np.unique(owner[at]))})"
             )
 
         # Two cells sharing an edge must traverse it in opposite directions.
-        order = np.argsort(edge_id, kind="stable")
-        sorted_ids = edge_id[order]
-        pair_start = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
-        first, second = order[pair_start], order[pair_start + 1]
+        first, second = table.pairs()
         same_direction = directed[first, 0] == directed[second, 0]
         if same_direction.any():
             bad = np.unique(
@@ -296,17 +291,16 @@ class SurfaceMesh:
                 "'vares panels FILE' takes each piece as a panel"
             )
 
-        self._check_manifold_vertices(directed, owner, edge_id)
+        self._check_manifold_vertices(table)
 
-    def _check_manifold_vertices(
-        self, directed: np.ndarray, owner: np.ndarray, edge_id: np.ndarray
-    ) -> None:
+    def _check_manifold_vertices(self, table: _EdgeTable) -> None:
         """Around each node the cells must form a single fan (no 'bow-tie' nodes)."""
-        corner_node, fan = corner_fans(self.num_points, directed, owner, edge_id)
-        fans_per_node = np.bincount(
-            np.unique(np.column_stack([corner_node, fan]), axis=0)[:, 0],
-            minlength=self.num_points,
+        corner_node, fan = corner_fans(
+            self.num_points, table.directed, table.owner, table.edge_id, table.order
         )
+        fan_node = np.empty(fan.max() + 1, dtype=np.int64)
+        fan_node[fan] = corner_node  # the corners of a fan are at one node
+        fans_per_node = np.bincount(fan_node, minlength=self.num_points)
         bow_tie = np.flatnonzero(fans_per_node > 1)
         if bow_tie.size:
             raise MeshError(
@@ -317,20 +311,25 @@ class SurfaceMesh:
 
 
 def corner_fans(
-    num_points: int, directed: np.ndarray, owner: np.ndarray, edge_id: np.ndarray
+    num_points: int,
+    directed: np.ndarray,
+    owner: np.ndarray,
+    edge_id: np.ndarray,
+    order: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The fan of every cell corner: corners (one per directed edge, at its start node) of the
     same node are in one fan when their cells are joined around the node by shared edges.
-    Returns the node and the fan label of every corner."""
+    ``order`` sorts the edges by ``edge_id`` (stable), if known. Returns the node and the fan
+    label of every corner."""
     corner_node = directed[:, 0]
     corner_key = owner * num_points + corner_node
-    order = np.argsort(corner_key)
-    sorted_key = corner_key[order]
+    by_key = np.argsort(corner_key)
+    sorted_key = corner_key[by_key]
 
     def corner_of(cell: np.ndarray, node: np.ndarray) -> np.ndarray:
-        return order[np.searchsorted(sorted_key, cell * num_points + node)]
+        return by_key[np.searchsorted(sorted_key, cell * num_points + node)]
 
-    srt = np.argsort(edge_id, kind="stable")
+    srt = np.argsort(edge_id, kind="stable") if order is None else order
     ids = edge_id[srt]
     pair = np.flatnonzero(ids[1:] == ids[:-1])
     a, b = srt[pair], srt[pair + 1]
@@ -347,6 +346,38 @@ def corner_fans(
     return corner_node, fan
 
 
+@dataclass(frozen=True)
+class _EdgeTable:
+    """Every directed cell edge, the cell it belongs to, the id of its undirected edge, the
+    number of cells at each undirected edge, and the stable order that sorts by edge id."""
+
+    directed: np.ndarray
+    owner: np.ndarray
+    edge_id: np.ndarray
+    counts: np.ndarray
+    order: np.ndarray
+
+    @classmethod
+    def of(cls, edges: tuple[np.ndarray, np.ndarray], num_points: int) -> _EdgeTable:
+        directed, owner = edges
+        key = np.minimum(directed[:, 0], directed[:, 1]) * num_points + np.maximum(
+            directed[:, 0], directed[:, 1]
+        )
+        order = np.argsort(key, kind="stable")
+        ordered = key[order]
+        start = np.ones(ordered.size, dtype=bool)
+        start[1:] = ordered[1:] != ordered[:-1]
+        edge_id = np.empty(key.size, dtype=np.int64)
+        edge_id[order] = np.cumsum(start) - 1
+        return cls(directed, owner, edge_id, np.bincount(edge_id), order)
+
+    def pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        """The two directed edges of every edge shared by (at least) two cells."""
+        ids = self.edge_id[self.order]
+        pair_start = np.flatnonzero(ids[1:] == ids[:-1])
+        return self.order[pair_start], self.order[pair_start + 1]
+
+
 def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.ndarray:
     """The piece (0, 1, …) of every cell (global cell order): cells are in one piece when a
     chain of shared edges joins them; the largest piece is 0."""
@@ -358,14 +389,11 @@ def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.
             directed.append(np.column_stack([block[:, i], block[:, (i + 1) % nen]]))
             owner.append(offset + np.arange(len(block)))
         offset += len(block)
-    key = np.sort(np.vstack(directed), axis=1)
-    owner = np.concatenate(owner)
-    _, edge_id = np.unique(key, axis=0, return_inverse=True)
-    edge_id = edge_id.ravel()
-    graph = sp.coo_matrix(
-        (np.ones(owner.size), (owner, edge_id)), shape=(offset, edge_id.max() + 1)
+    table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), len(points))
+    first, second = table.pairs()
+    adjacency = sp.coo_matrix(
+        (np.ones(first.size), (table.owner[first], table.owner[second])), shape=(offset, offset)
     )
-    adjacency = (graph @ graph.T).tocsr()
     _, label = connected_components(adjacency, directed=False)
     sizes = np.bincount(label)
     rank = np.empty_like(sizes)

@@ -27,7 +27,7 @@ from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 from scipy.spatial import cKDTree
 
-from .mesh import MeshError, _listing, corner_fans
+from .mesh import MeshError, _EdgeTable, _listing, corner_fans
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
 
@@ -191,14 +191,21 @@ def _drop(blocks, owners, condition):
     return out_blocks, out_owners, dropped
 
 
+def _num_nodes(blocks: dict[str, np.ndarray]) -> int:
+    return int(max((b.max() for b in blocks.values() if b.size), default=-1)) + 1
+
+
 def _collapsed(block: np.ndarray) -> np.ndarray:
     return (np.diff(np.sort(block, axis=1), axis=1) == 0).any(axis=1)
 
 
 def _duplicates(block: np.ndarray) -> np.ndarray:
-    _, first = np.unique(np.sort(block, axis=1), axis=0, return_index=True)
-    duplicate = np.ones(len(block), dtype=bool)
-    duplicate[first] = False
+    ordered = np.sort(block, axis=1)
+    order = np.lexsort(ordered.T[::-1])
+    same = np.zeros(len(block), dtype=bool)
+    same[1:] = (ordered[order[1:]] == ordered[order[:-1]]).all(axis=1)
+    duplicate = np.zeros(len(block), dtype=bool)
+    duplicate[order[same]] = True  # every repeat after the first of its kind
     return duplicate
 
 
@@ -236,14 +243,11 @@ def _orient(blocks: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], int]:
             directed.append(np.column_stack([block[:, i], block[:, (i + 1) % block.shape[1]]]))
             owner.append(offset + np.arange(len(block)))
         offset += len(block)
-    directed, owner = np.vstack(directed), np.concatenate(owner)
-    key = np.sort(directed, axis=1)
-    _, edge_id, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    edge_id = edge_id.ravel()
-    order = np.argsort(edge_id, kind="stable")
-    ids = edge_id[order]
-    pair = np.flatnonzero((ids[1:] == ids[:-1]) & (counts[ids[1:]] == 2))
-    a, b = order[pair], order[pair + 1]
+    table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), _num_nodes(blocks))
+    directed, owner, counts = table.directed, table.owner, table.counts
+    a, b = table.pairs()
+    manifold = counts[table.edge_id[a]] == 2
+    a, b = a[manifold], b[manifold]
     same = (directed[a, 0] == directed[b, 0]).astype(np.int8)
     if not same.any():
         return blocks, 0
@@ -290,9 +294,8 @@ def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
         offset += len(block)
     if not offset:
         return points, blocks, 0
-    directed, owner = np.vstack(directed), np.concatenate(owner)
-    _, edge_id = np.unique(np.sort(directed, axis=1), axis=0, return_inverse=True)
-    node, fan = corner_fans(len(points), directed, owner, edge_id.ravel())
+    table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), len(points))
+    node, fan = corner_fans(len(points), table.directed, table.owner, table.edge_id, table.order)
     pairs, label = np.unique(np.column_stack([node, fan]), axis=0, return_inverse=True)
     extra = np.r_[False, pairs[1:, 0] == pairs[:-1, 0]]  # a node's second fan onward
     if not extra.any():

@@ -65,9 +65,12 @@ def _numbers(tokens: list[str], path: Path, line: int, kind=float) -> list:
 def read_obj(path: Path) -> PolygonSoup:
     """Vertices (``v x y z [w]``) and faces (``f a b c …`` with ``a``, ``a/t``, ``a//n`` or
     ``a/t/n``; 1-based, negative = relative to the end) of a Wavefront OBJ file."""
+    text = _text(path)
+    fast = _plain_obj(text)
+    if fast is not None:
+        return fast
     points: list[list[float]] = []
     faces: list[list[int]] = []
-    text = _text(path)
     for number, line in enumerate(text.splitlines(), start=1):
         tokens = line.split()
         if not tokens:
@@ -82,6 +85,33 @@ def read_obj(path: Path) -> PolygonSoup:
             # 1-based; negative counts back from the vertices read so far
             faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
     return _soup(points, faces, path)
+
+
+def _plain_obj(text: str) -> PolygonSoup | None:
+    """The common case read at numpy speed: ``v x y z`` lines and triangle or quad faces of
+    positive plain indices only; ``None`` for anything else (read line by line instead)."""
+    lines = text.split("\n")
+    vertices = [line[2:] for line in lines if line.startswith("v ")]
+    faces = [line[2:] for line in lines if line.startswith("f ")]
+    if not vertices or not faces or "/" in "".join(faces[:1]) or "-" in "".join(faces[:100]):
+        return None
+    try:
+        points = np.array(" ".join(vertices).split(), dtype=float)
+        indices = np.array(" ".join(faces).split(), dtype=np.int64)
+    except ValueError:
+        return None
+    sizes = {len(faces[0].split()), len(faces[-1].split())}
+    if (
+        points.size != 3 * len(vertices)
+        or len(sizes) != 1
+        or indices.size != len(faces) * min(sizes)
+    ):
+        return None
+    nen = sizes.pop()
+    if nen not in (3, 4) or indices.min() < 1 or indices.max() > len(vertices):
+        return None
+    cells = {"triangle" if nen == 3 else "quad": indices.reshape(-1, nen) - 1}
+    return PolygonSoup(points.reshape(-1, 3), cells)
 
 
 def read_off(path: Path) -> PolygonSoup:

@@ -36,18 +36,15 @@ class Assembler:
         self.num_dofs = 2 * n
         self.num_free = int(free.sum())
 
-        # Node-level pattern first (a quarter of the entries to sort), then each node pair
-        # (a, b) becomes the 2 × 2 dof block of rows 2a+i, columns 2b+j.
-        pairs = [
-            (cells[:, :, None] * n + cells[:, None, :]).ravel() for cells in mesh.cells.values()
-        ]
-        node_keys, node_entry = np.unique(np.concatenate(pairs), return_inverse=True)
-        node_entry = node_entry.ravel()
-        node_row, node_col = node_keys // n, node_keys % n
-        node_ptr = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(node_row, minlength=n), out=node_ptr[1:])
+        # Node-level pattern first (a quarter of the entries), then each node pair (a, b)
+        # becomes the 2 × 2 dof block of rows 2a+i, columns 2b+j.
+        node_ptr, node_col = _node_pattern(mesh)
         degree = np.diff(node_ptr)
-        within = np.arange(node_keys.size) - node_ptr[node_row]  # rank of b in row a
+        node_row = np.repeat(np.arange(n), degree)
+        within = np.arange(node_col.size) - node_ptr[node_row]  # rank of b in row a
+        node_entry = np.concatenate(
+            [_node_entries(cells, node_ptr, node_col) for cells in mesh.cells.values()]
+        )
 
         i = np.arange(2)[:, None]
         j = np.arange(2)[None, :]
@@ -60,7 +57,7 @@ class Assembler:
         # full dof structure, then keep the free rows and columns
         rows = (2 * node_row[:, None, None] + i + 0 * j).ravel()
         cols = (2 * node_col[:, None, None] + j + 0 * i).ravel()
-        order = full_position(np.arange(node_keys.size)).ravel()
+        order = full_position(np.arange(node_col.size)).ravel()
         full_rows = np.empty_like(rows)
         full_cols = np.empty_like(cols)
         full_rows[order], full_cols[order] = rows, cols
@@ -110,6 +107,38 @@ class Assembler:
         return sp.csr_matrix(
             (data, self._indices, self._indptr), shape=(self.num_free, self.num_free)
         )
+
+
+def _node_pattern(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
+    """CSR pattern (row pointer, sorted column indices) of the node pairs that share a cell."""
+    n = mesh.num_points
+    rows = np.concatenate([np.repeat(c, c.shape[1], axis=1).ravel() for c in mesh.cells.values()])
+    cols = np.concatenate([np.tile(c, (1, c.shape[1])).ravel() for c in mesh.cells.values()])
+    pattern = sp.csr_matrix(
+        (np.ones(rows.size, dtype=np.int8), (rows.astype(np.int32), cols.astype(np.int32))),
+        shape=(n, n),
+    )
+    pattern.sum_duplicates()  # sorted, unique columns in every row
+    return pattern.indptr.astype(np.int64), pattern.indices.astype(np.int64)
+
+
+@njit(cache=True)
+def _node_entries(cells, node_ptr, node_col):  # pragma: no cover - compiled
+    """Index in the node pattern of every node pair ``(m, a, b)`` of the cells, flattened."""
+    m, nen = cells.shape
+    out = np.empty(m * nen * nen, dtype=np.int64)
+    k = 0
+    for e in range(m):
+        for a in range(nen):
+            row = cells[e, a]
+            for b in range(nen):
+                column = cells[e, b]
+                position = node_ptr[row]
+                while node_col[position] != column:
+                    position += 1
+                out[k] = position
+                k += 1
+    return out
 
 
 @njit(cache=True)

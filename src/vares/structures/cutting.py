@@ -21,10 +21,10 @@ from ..geometry.line_families import boundary_loops_3d
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.outline import allowance_outline
 from ..geometry.surface_lines import min_angles, triangulated
-from ..units import unit_factor
 from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
 from ..solver import IterationRecord, SolveOptions
+from ..units import unit_factor
 from .layout import StripPlan, plan_strips, strips_along_lines, width_across
 from .matching import StructureResult, solve_structure
 from .nesting import RollNest, nest_pieces
