@@ -323,6 +323,7 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
     single = _cli("pattern", source, "-o", tmp_path / "single", "--plot", "det_F", "-q")
     assert single.exit_code == 0, single.stderr
     expected = {p.name for p in (tmp_path / "single").iterdir()} | {"surface.obj", "report.html"}
+    expected -= {"job.toml"}  # the job goes into the structure's folder, not into each panel's
     names = ["panel-0", "panel-1"]
     for name in names:
         assert {p.name for p in (out / name).iterdir()} == expected
@@ -331,6 +332,7 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
         "structure.json",
         "structure.dxf",
         "report.html",
+        "job.toml",
     }
     report = (out / "report.html").read_text()
     assert all(f'href="{name}/report.html"' in report for name in names)

@@ -43,13 +43,20 @@ def _summary_path(job: Job) -> Path:
 
 
 def is_complete(job: Job) -> bool:
-    """True when the job's outputs exist, converged, and were written for this very job."""
-    path = _summary_path(job)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    """True when the job's outputs exist, converged, and were written for this very job (and,
+    with an erection, its ``erect.json`` says it converged)."""
+    paths = [_summary_path(job)]
+    if job.erection is not None:
+        paths.append(job.directory / "erect" / "erect.json")
+    data = []
+    for path in paths:
+        try:
+            data.append(json.loads(path.read_text(encoding="utf-8")))
+        except (OSError, ValueError):
+            return False
+    if not all(d.get("converged") for d in data):
         return False
-    return bool(data.get("converged")) and data.get("job_digest") == job.digest()
+    return data[0].get("job_digest") == job.digest()
 
 
 def _limit_threads(threads: int) -> None:

@@ -32,6 +32,10 @@ in :mod:`vares.options`); an unknown table or key is an error naming the closest
     [structure]                  # present: the input is a structure of several panels
     match_seams = true
 
+    [erection]                   # present: erect the structure from its patterns afterwards
+    wrinkling = true
+    pressure = 0.0
+
 Relative paths are relative to the job file's folder, so a job folder can be moved or shared.
 """
 
@@ -45,6 +49,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ..analysis.options import ErectionOptions
 from ..options import Options, OptionsError, Spec
 from ..solver.options import SolveOptions
 from ..structures.options import StructureOptions
@@ -66,13 +71,17 @@ SECTIONS: dict[str, str] = {
     "solver": "solve",
     "output": "output",
     "structure": "structure",
+    "erection": "erection",
 }
+#: Tables whose presence means something even when empty.
+_PRESENCE = ("structure", "erection")
 
 
 @dataclass(frozen=True)
 class Job:
     """A patterning job: one options object per part; ``structure`` is set for a structure of
-    several panels. ``base`` is the folder relative paths are relative to."""
+    several panels, ``erection`` when the structure is to be erected from its patterns after
+    patterning. ``base`` is the folder relative paths are relative to."""
 
     input: InputOptions
     material: MaterialOptions = field(default_factory=MaterialOptions)
@@ -80,6 +89,7 @@ class Job:
     prestress: PrestressOptions = field(default_factory=PrestressOptions)
     output: OutputOptions = field(default_factory=OutputOptions)
     structure: StructureOptions | None = None
+    erection: ErectionOptions | None = None
     base: Path = field(default_factory=Path.cwd)
 
     @classmethod
@@ -104,7 +114,7 @@ class Job:
             parts.setdefault(SECTIONS[section], {}).update(values)
         built = {}
         for part, values in parts.items():
-            if part == "structure" or values or part == "input":
+            if part in _PRESENCE or values or part == "input":
                 built[part] = _build(_PARTS[part], values, origin)
         if "input" not in built:
             raise JobError(f"{origin}: [input] needs exactly one of mesh, meshes or example")
@@ -122,7 +132,7 @@ class Job:
             for key, spec in options.specs().items():
                 if key in values and spec.kind in ("path", "paths"):
                     values[key] = _relocated(values[key], self.base, location)
-            if values or section == "structure":
+            if values or section in _PRESENCE:
                 out[section] = values
         return out
 
@@ -164,6 +174,7 @@ _PARTS: dict[str, type[Options]] = {
     "prestress": PrestressOptions,
     "output": OutputOptions,
     "structure": StructureOptions,
+    "erection": ErectionOptions,
 }
 
 

@@ -13,9 +13,21 @@ One pattern (in the output directory; for a structure, in a folder per panel):
 
 A structure adds ``structure.json`` (panels, seams before and after matching, the energy price,
 the roll width check), ``structure.dxf`` (all patterns with matching marks) and, with ``report``,
-its own ``report.html``. Every target is checked before the solve (nothing is overwritten without
-``force``); every file is written atomically. A solve that does not converge writes only the
-summaries.
+its own ``report.html``. Every job writes ``job.toml`` into the output directory: the job as it
+ran (paths relative to it), from which ``vares erect DIR`` (and ``vares run DIR/job.toml -o …``)
+take the input, material, fibres and prestress. An erection (``[erection]``, ``--erect``, ``vares
+erect``) writes into ``erect/``:
+
+``erect.json``                  the key figures (converged, deviation, stresses against the
+                                intended prestress, wrinkled and slack area) and the history
+``erected.vtu``                 the erected surface with the displacement and normal deviation
+                                per node, the membrane forces and states (and those on the design
+                                shape, ``design_*``) per cell
+``erected.obj``                 the erected surface
+``deviation.png``, ``warp_stress.png``, ``fill_stress.png``, ``state.png``  drawn on it
+
+Every target is checked before the solve (nothing is overwritten without ``force``); every file is
+written atomically. A solve that does not converge writes only the summaries (and is not erected).
 """
 
 from __future__ import annotations
@@ -26,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .._version import __version__
+from ..analysis.erection import ErectionResult
 from ..analysis.statistics import field_statistics
 from ..io.dxf import UNITS, CutPiece, write_dxf
 from ..io.files import atomic_path, write_json
@@ -33,12 +46,24 @@ from ..io.meshes import write_surface
 from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
-from .inputs import Input
+from .inputs import Input, safe_name
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
 from .sections import STRUCTURE_MARK_SPACING
 
-__all__ = ["panel_directory", "planned_files", "safe_name", "write_panel", "write_structure"]
+__all__ = [
+    "ERECTION_FILES",
+    "JOB_FILE",
+    "erection_directory",
+    "erection_files",
+    "panel_directory",
+    "planned_files",
+    "safe_name",
+    "write_erection",
+    "write_job_file",
+    "write_panel",
+    "write_structure",
+]
 
 PATTERN_FILES = (
     "summary.json",
@@ -49,11 +74,18 @@ PATTERN_FILES = (
     "pattern.vtu",
     "surface.vtu",
 )
-
-
-def safe_name(name: str) -> str:
-    """A panel name as a folder name (letters, digits, ``-_.``)."""
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "panel"
+#: The job as it ran, in the output directory.
+JOB_FILE = "job.toml"
+#: The files of an erection, in the output directory's ``erect/``.
+ERECTION_FILES = (
+    "erect.json",
+    "erected.vtu",
+    "erected.obj",
+    "deviation.png",
+    "warp_stress.png",
+    "fill_stress.png",
+    "state.png",
+)
 
 
 def panel_directory(job: Job, name: str) -> Path:
@@ -81,6 +113,77 @@ def planned_files(job: Job, source: Input) -> list[Path]:
     if job.structure is not None:
         names = ["structure.json", "structure.dxf"] + (["report.html"] if job.output.report else [])
         files += [job.directory / n for n in names]
+    files.append(job.directory / JOB_FILE)
+    if job.erection is not None:
+        files += erection_files(erection_directory(job))
+    return files
+
+
+def erection_directory(job: Job) -> Path:
+    """Where an erection's files go: ``erect/`` in the output directory."""
+    return job.directory / "erect"
+
+
+def erection_files(directory: Path, report: bool = False) -> list[Path]:
+    """The files an erection writes into ``directory``."""
+    return [directory / n for n in ERECTION_FILES + (("report.html",) if report else ())]
+
+
+def write_job_file(job: Job) -> Path:
+    """``job.toml`` in the output directory: the job as it ran, paths relative to it."""
+    path = job.directory / JOB_FILE
+    with atomic_path(path) as temporary:
+        temporary.write_text(job.to_toml(path), encoding="utf-8")
+    return path
+
+
+def write_erection(result: ErectionResult, directory: Path, units: str) -> list[Path]:
+    """The files of an erection (:data:`ERECTION_FILES`) in ``directory``; returns their paths."""
+    import matplotlib.pyplot as plt
+
+    from ..io.plot import plot_surface
+
+    files = []
+    fields = dict(result.fields) | {f"design_{k}": v for k, v in result.design_fields.items()}
+    points = {
+        "displacement": result.displacement,
+        "normal_deviation": result.normal_deviation,
+        "held": result.held.astype(float),
+    }
+    writers = {
+        "erect.json": lambda p: write_json(p, result.to_dict(units=units)),
+        "erected.vtu": lambda p: write_surface(
+            p, result.mesh, result.erected_points, fields, points
+        ),
+        "erected.obj": lambda p: write_surface(p, result.mesh, result.erected_points),
+    }
+    for name, writer in writers.items():
+        writer(directory / name)
+        files.append(directory / name)
+    erected = result.erected_mesh
+    per_cell = np.concatenate(
+        [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
+    )
+    scale = result.material.stiffness_scale * result.thickness
+    drawings = {
+        "deviation.png": (per_cell, "normal_deviation", f"normal deviation ({units})"),
+        "warp_stress.png": (result.fields["warp_stress"], "warp_stress", "warp force, erected"),
+        "fill_stress.png": (result.fields["fill_stress"], "fill_stress", "fill force, erected"),
+        "state.png": (result.fields["state"], "state", "taut / wrinkled / slack, erected"),
+    }
+    for name, (values, field, title) in drawings.items():
+        fig = plot_surface(
+            erected,
+            values,
+            field=field,
+            title=title,
+            stress_unit="force/length",
+            stress_scale=scale,
+        )
+        with atomic_path(directory / name) as temporary:
+            fig.savefig(temporary, dpi=150)
+        plt.close(fig)
+        files.append(directory / name)
     return files
 
 

@@ -4,101 +4,31 @@ One file per pattern with everything inline (pictures as embedded PNG): the inpu
 and its parameters, the solver's path and convergence history, the pattern drawn with its yarn
 directions, the result fields on the pattern and on the 3D surface, the key figures and the
 warnings. A structure gets one more, for the whole: its panels, its seams before and after
-matching, and links to the panels' reports.
+matching, and links to the panels' reports. A job that erects its structure adds the erection
+section (:mod:`vares.app.erection_report`) to the pattern's report (the structure's, for a
+structure).
 """
 
 from __future__ import annotations
 
-import base64
-import datetime
 import html
-import io
 from pathlib import Path
 
 import numpy as np
 
-from .._version import __version__
+from ..analysis.erection import ErectionResult
 from ..analysis.statistics import field_statistics
 from ..io.files import atomic_path
 from ..materials import Hyperelastic
 from ..mechanics.fields import KEY_FIELDS
+from .erection_report import erection_section
+from .html_parts import figure, number, page, status_text, table
 from .job import Job
 from .outcome import JobOutcome, PanelOutcome
 
 __all__ = ["html_report", "structure_report", "write_reports"]
 
-_STYLE = """
-body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
-h1 { margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; }
-table { border-collapse: collapse; margin: 0.5em 0 1em; }
-td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }
-th { background: #f2f4f7; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
-.status-ok { color: #17702a; font-weight: bold; } .status-bad { color: #b00020; font-weight: bold; }
-.warning { background: #fff4d6; border-left: 4px solid #e0a800; padding: 0.4em 0.8em;
-  margin: 0.3em 0; }
-figure { display: inline-block; margin: 0.5em; vertical-align: top; }
-figure img { max-width: 520px; border: 1px solid #ddd; }
-figcaption { font-size: 0.9em; color: #555; }
-"""
-
 _FIGURE_FIELDS = ("det_F", "warp_stress", "fill_stress", "shear_angle", "stress_min")
-
-
-def _png(fig) -> str:
-    import matplotlib.pyplot as plt
-
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100)
-    plt.close(fig)
-    return base64.b64encode(buffer.getvalue()).decode("ascii")
-
-
-def _figure(fig, caption: str, ident: str) -> str:
-    return (
-        f'<figure id="{ident}"><img alt="{html.escape(caption)}" '
-        f'src="data:image/png;base64,{_png(fig)}"><figcaption>{html.escape(caption)}'
-        "</figcaption></figure>"
-    )
-
-
-def _table(rows, header=None, ident: str | None = None) -> str:
-    attr = f' id="{ident}"' if ident else ""
-    out = [f"<table{attr}>"]
-    if header:
-        out.append("<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>")
-    for row in rows:
-        cells = []
-        for k, cell in enumerate(row):
-            text = html.escape(str(cell))
-            cells.append(f"<th>{text}</th>" if k == 0 else f'<td class="num">{text}</td>')
-        out.append("<tr>" + "".join(cells) + "</tr>")
-    out.append("</table>")
-    return "".join(out)
-
-
-def _g(value: float, digits: int = 5) -> str:
-    return f"{value:.{digits}g}"
-
-
-def _page(title: str, heading: str, status: str, warnings: list[str]) -> list[str]:
-    """The head of a report: title, version, date, status and the warnings."""
-    parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        f"<title>vares report: {html.escape(title)}</title><style>{_STYLE}</style>",
-        "</head><body>",
-        f"<h1>{html.escape(heading)}</h1>",
-        f"<p>vares {__version__}, {datetime.datetime.now():%Y-%m-%d %H:%M}. Status: {status}</p>",
-        "<h2>Warnings</h2>",
-    ]
-    if warnings:
-        return parts + [f'<div class="warning">{html.escape(w)}</div>' for w in warnings]
-    return [*parts, "<p id='no-warnings'>None.</p>"]
-
-
-def _status(converged: bool, reason: str | None) -> str:
-    if converged:
-        return '<span class="status-ok">converged</span>'
-    return f'<span class="status-bad">not converged: {html.escape(str(reason))}</span>'
 
 
 def _input_section(outcome: PanelOutcome, job: Job) -> list[str]:
@@ -109,10 +39,10 @@ def _input_section(outcome: PanelOutcome, job: Job) -> list[str]:
         ("source", source),
         ("nodes", mesh.num_points),
         ("cells", cells),
-        ("surface area", f"{_g(mesh.area)} {units}²"),
-        ("extent (x, y, z)", " × ".join(_g(v, 4) for v in np.ptp(mesh.points, axis=0))),
+        ("surface area", f"{number(mesh.area)} {units}²"),
+        ("extent (x, y, z)", " × ".join(number(v, 4) for v in np.ptp(mesh.points, axis=0))),
     ]
-    return ["<h2>Input</h2>", _table(rows, ident="input")]
+    return ["<h2>Input</h2>", table(rows, ident="input")]
 
 
 def _material_section(result, job: Job, material: Hyperelastic) -> list[str]:
@@ -133,19 +63,19 @@ def _material_section(result, job: Job, material: Hyperelastic) -> list[str]:
         rows.append(
             (
                 "prestress warp / fill",
-                f"{_g(float(p[:, 0].mean()))} / {_g(float(p[:, 1].mean()))}{per_cell}",
+                f"{number(float(p[:, 0].mean()))} / {number(float(p[:, 1].mean()))}{per_cell}",
             )
         )
-    return ["<h2>Material and fibres</h2>", _table(rows, ident="material")]
+    return ["<h2>Material and fibres</h2>", table(rows, ident="material")]
 
 
 def _key_figures(outcome: PanelOutcome, units: str) -> list[str]:
     result, mesh = outcome.result, outcome.mesh
     key = [
-        ("surface area", f"{_g(mesh.area)} {units}²"),
-        ("pattern area", f"{_g(result.pattern_area)} {units}²"),
+        ("surface area", f"{number(mesh.area)} {units}²"),
+        ("pattern area", f"{number(result.pattern_area)} {units}²"),
         ("pattern / surface area", f"{100 * (result.pattern_area / mesh.area - 1):+.3f} %"),
-        ("energy", _g(result.energy)),
+        ("energy", number(result.energy)),
         ("Newton iterations", result.iterations),
         ("strategy", " → ".join(result.strategy)),
         ("initial guess", result.initial_guess),
@@ -157,14 +87,17 @@ def _key_figures(outcome: PanelOutcome, units: str) -> list[str]:
         for name in KEY_FIELDS:
             s = stats[name]
             key.append(
-                (f"{name} (min / mean / max)", f"{_g(s['min'])} / {_g(s['mean'])} / {_g(s['max'])}")
+                (
+                    f"{name} (min / mean / max)",
+                    f"{number(s['min'])} / {number(s['mean'])} / {number(s['max'])}",
+                )
             )
         key.append(("wrinkling area", f"{100 * stats['wrinkling']['mean']:.1f} %"))
-    parts = ["<h2>Key figures</h2>", _table(key, ident="key-figures")]
+    parts = ["<h2>Key figures</h2>", table(key, ident="key-figures")]
     if outcome.compensation is not None and result.prestress is not None:
         parts += [
             "<h2>Compensation and prestress</h2>",
-            _table(outcome.compensation.rows(), header=("", "warp", "fill"), ident="compensation"),
+            table(outcome.compensation.rows(), header=("", "warp", "fill"), ident="compensation"),
         ]
     return parts
 
@@ -185,12 +118,12 @@ def _convergence_section(result) -> list[str]:
     ]
     return [
         "<h2>Convergence</h2>",
-        _figure(
+        figure(
             plot_convergence(result.history),
             "relative residual per Newton iteration",
             "figure-convergence",
         ),
-        _table(
+        table(
             steps,
             header=("strategy", "step", "τ", "iterations", "converged", "reason"),
             ident="steps",
@@ -206,17 +139,17 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
     scale = material.stiffness_scale * result.thickness
     parts = [
         "<h2>Pattern</h2>",
-        _figure(
+        figure(
             plot_pattern(mesh, x, fibres=result.fibres, title="pattern"),
             "the pattern with warp and fill",
             "figure-pattern",
         ),
     ]
     for name in _FIGURE_FIELDS:
-        figure = plot_pattern(
+        drawing = plot_pattern(
             mesh, x, fields[name], field=name, fibres=result.fibres, title=name, stress_scale=scale
         )
-        parts.append(_figure(figure, f"{name} on the pattern", f"figure-{name}"))
+        parts.append(figure(drawing, f"{name} on the pattern", f"figure-{name}"))
     surface_det_f = plot_surface(mesh, fields["det_F"], field="det_F", title="det F")
     surface_warp = plot_surface(
         mesh, fields["warp_stress"], field="warp_stress", title="warp stress", stress_scale=scale
@@ -224,18 +157,24 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
     return [
         *parts,
         "<h2>On the surface</h2>",
-        _figure(surface_det_f, "det F on the 3D surface", "figure-surface-det_F"),
-        _figure(surface_warp, "warp stress on the 3D surface", "figure-surface-warp_stress"),
+        figure(surface_det_f, "det F on the 3D surface", "figure-surface-det_F"),
+        figure(surface_warp, "warp stress on the 3D surface", "figure-surface-warp_stress"),
     ]
 
 
-def html_report(outcome: PanelOutcome, job: Job, material: Hyperelastic) -> str:
-    """The report of one pattern of a job as one HTML document."""
+def html_report(
+    outcome: PanelOutcome,
+    job: Job,
+    material: Hyperelastic,
+    erection: ErectionResult | None = None,
+) -> str:
+    """The report of one pattern of a job as one HTML document (with the erection's section
+    when it was erected)."""
     result = outcome.result
-    parts = _page(
+    parts = page(
         outcome.name,
         f"Cutting pattern: {outcome.name}",
-        _status(result.converged, result.reason),
+        status_text(result.converged, result.reason),
         outcome.warnings,
     )
     parts += _input_section(outcome, job)
@@ -244,10 +183,12 @@ def html_report(outcome: PanelOutcome, job: Job, material: Hyperelastic) -> str:
     parts += _convergence_section(result)
     if result.converged:
         parts += _pattern_figures(outcome, material)
+    if erection is not None:
+        parts += erection_section(erection, job.input.units)
     files = [(f.name, str(f)) for f in outcome.files]
     parts += [
         "<h2>Files</h2>",
-        _table(files, header=("file", "path"), ident="files"),
+        table(files, header=("file", "path"), ident="files"),
         "</body></html>",
     ]
     return "\n".join(parts)
@@ -261,8 +202,8 @@ def structure_report(outcome: JobOutcome) -> str:
         (
             p.name,
             p.mesh.num_cells,
-            f"{_g(p.mesh.area)} {units}²",
-            f"{_g(p.result.pattern_area)} {units}²",
+            f"{number(p.mesh.area)} {units}²",
+            f"{number(p.result.pattern_area)} {units}²",
             "yes" if p.result.converged else "no",
             p.result.iterations,
         )
@@ -276,8 +217,8 @@ def structure_report(outcome: JobOutcome) -> str:
         (
             f"{s.first} | {s.second}",
             s.segments,
-            _g(s.length_first_after, 8),
-            _g(s.length_second_after, 8),
+            number(s.length_first_after, 8),
+            number(s.length_second_after, 8),
             f"{s.mismatch_before:.2e}",
             f"{s.mismatch_after:.2e}",
         )
@@ -288,31 +229,33 @@ def structure_report(outcome: JobOutcome) -> str:
         ("seams", len(structure.seams)),
         ("seam matching", "yes" if structure.matched else "no"),
         ("coupled iterations", structure.iterations),
-        ("energy, panels alone", _g(structure.energy_independent)),
-        ("energy, seams matched", _g(structure.energy)),
+        ("energy, panels alone", number(structure.energy_independent)),
+        ("energy, seams matched", number(structure.energy)),
         ("price of matching", f"{structure.energy_price:.3e}"),
         ("time", f"{structure.elapsed:.2f} s"),
     ]
-    status = _status(structure.converged, structure.reason)
+    state = status_text(structure.converged, structure.reason)
     parts = [
-        *_page("structure", "Structure", status, outcome.warnings),
+        *page("structure", "Structure", state, outcome.warnings),
         "<h2>Key figures</h2>",
-        _table(key, ident="key-figures"),
+        table(key, ident="key-figures"),
         "<h2>Panels</h2>",
-        _table(
+        table(
             panels,
             header=("panel", "cells", "surface area", "pattern area", "converged", "iterations"),
             ident="panels",
         ),
         f"<ul id='panel-reports'>{links}</ul>",
         "<h2>Seams (pattern lengths)</h2>",
-        _table(
+        table(
             seams,
             header=("seam", "segments", "length A", "length B", "mismatch before", "after"),
             ident="seams",
         ),
-        "</body></html>",
     ]
+    if outcome.erection is not None:
+        parts += erection_section(outcome.erection, units)
+    parts.append("</body></html>")
     return "\n".join(parts)
 
 
@@ -321,7 +264,8 @@ def write_reports(outcome: JobOutcome) -> None:
     the outcome's file lists."""
     for panel in outcome.panels:
         path = panel.directory / "report.html"
-        _write_text(path, html_report(panel, outcome.job, outcome.material))
+        erection = outcome.erection if outcome.structure is None else None
+        _write_text(path, html_report(panel, outcome.job, outcome.material, erection))
         panel.files.append(path)
         outcome.files.append(path)
     if outcome.structure is not None:

@@ -1,35 +1,47 @@
-"""Running a job: read the input, solve (one surface, or a structure's panels), write the files.
+"""Running a job: read the input, solve (one surface, or a structure's panels), erect the
+structure from its patterns if asked, write the files.
 
-The one runner behind ``vares pattern``, ``example``, ``run``, ``panels`` and ``batch``: every
-command builds a :class:`vares.app.job.Job` and hands it here, so they all get the same outputs
-(see :mod:`vares.app.outputs`).
+The one runner behind ``vares pattern``, ``example``, ``run``, ``panels``, ``batch`` and
+``erect``: every command builds a :class:`vares.app.job.Job` and hands it here, so they all get
+the same outputs (see :mod:`vares.app.outputs`). :func:`run_erection` erects the patterns an
+earlier run wrote (``vares erect DIR``).
 """
 
 from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
 
 from ..analysis.checks import pattern_warnings
 from ..analysis.compensation import compensation_report
+from ..analysis.erection import ErectionResult, erect
+from ..analysis.erection_model import Pattern
+from ..analysis.options import ErectionOptions
 from ..geometry.examples import EXAMPLE_PLANES
 from ..geometry.mesh import SurfaceMesh
 from ..io.files import check_writable
 from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, solve
 from ..structures.matching import solve_structure
-from .inputs import Input, load_input
-from .job import Job, JobError
+from .inputs import Input, load_input, saved_patterns
+from .job import Job, JobError, load_job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import (
+    JOB_FILE,
+    erection_directory,
+    erection_files,
     panel_directory,
     planned_files,
     structure_marks,
+    write_erection,
+    write_job_file,
     write_panel,
     write_structure,
 )
 
-__all__ = ["run_job"]
+__all__ = ["ErectionRun", "run_erection", "run_job"]
 
 
 def run_job(
@@ -62,17 +74,91 @@ def run_job(
     outcome.warnings = [str(w.message) for w in caught] + outcome.warnings
     for panel in outcome.panels:
         panel.warnings = outcome.warnings + panel.warnings
-    marks = structure_marks(outcome) if outcome.structure and outcome.converged else None
+    marks = structure_marks(outcome) if outcome.structure and outcome.patterned else None
     for index, panel in enumerate(outcome.panels):
         write_panel(panel, job, material.stiffness_scale, None if marks is None else marks[index])
         outcome.files += panel.files
     if outcome.structure is not None:
         write_structure(outcome, marks)
+    outcome.files.append(write_job_file(job))
+    if job.erection is not None:
+        _erect(outcome, options, callback)
     if job.output.report:
         from .report import write_reports
 
         write_reports(outcome)
     return outcome
+
+
+def _erect(outcome: JobOutcome, options, callback) -> None:
+    """Erect the structure from the job's patterns and write ``erect/`` (patterns that did not
+    converge are not erected: a warning says so)."""
+    job = outcome.job
+    if not outcome.patterned:
+        outcome.warnings.append("not erected: the patterns did not converge")
+        return
+    patterns = [Pattern.of(p.result, p.name) for p in outcome.panels]
+    outcome.erection = erect(
+        patterns,
+        outcome.material,
+        job.material.thickness,
+        solver=options,
+        options=job.erection,
+        callback=callback,
+    )
+    outcome.files += write_erection(outcome.erection, erection_directory(job), job.input.units)
+
+
+@dataclass
+class ErectionRun:
+    """What ``vares erect DIR`` did: the job it read, the erection and the files written."""
+
+    job: Job
+    result: ErectionResult
+    files: list[Path] = field(default_factory=list)
+
+
+def run_erection(
+    directory: str | Path,
+    options: ErectionOptions | None = None,
+    *,
+    force: bool = False,
+    report: bool = False,
+    callback: Callable[[IterationRecord], None] | None = None,
+) -> ErectionRun:
+    """Erect the patterns that a run wrote into ``directory`` (from its ``job.toml``, the panels'
+    ``surface.vtu``, ``pattern.vtu`` and ``summary.json``) and write ``directory/erect/``.
+
+    ``options`` default to the job's ``[erection]`` table (or the defaults); the tolerance,
+    iteration limit and linear solver are the job's.
+    """
+    directory = Path(directory)
+    job_file = directory / JOB_FILE
+    if not job_file.is_file():
+        raise FileNotFoundError(
+            f"no {JOB_FILE} in {directory}: erect an output directory written by "
+            "'vares pattern', 'example', 'run' or 'panels'"
+        )
+    job = load_job(job_file)
+    options = options or job.erection or ErectionOptions()
+    material = job.material.build(job.base)
+    patterns = saved_patterns(job)
+    target = directory / "erect"
+    check_writable(erection_files(target, report), force)
+    result = erect(
+        patterns,
+        material,
+        job.material.thickness,
+        solver=job.solve,
+        options=options,
+        callback=callback,
+    )
+    run = ErectionRun(job, result, write_erection(result, target, job.input.units))
+    if report:
+        from .erection_report import write_erection_report
+
+        run.files.append(write_erection_report(run.result, target, job.input.units))
+    return run
 
 
 def _panel(job: Job, name: str, mesh: SurfaceMesh, result: PatternResult) -> PanelOutcome:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import typer
 
 from .batch import batch
+from .erect import erect
 from .evaluate import evaluate
 from .fabrics import fabrics
 from .panels import panels
@@ -19,7 +20,7 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-for command in (pattern, example, run, evaluate, fabrics, panels, batch):
+for command in (pattern, example, run, evaluate, fabrics, panels, erect, batch):
     app.command()(command)
 
 
