@@ -24,6 +24,7 @@ from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..mechanics.assembly import Assembler
 from ..mechanics.erection import Cables, ErectionProblem
+from ..mechanics.wrinkling import WrinklingError
 from ..options import split_settings, takes_options
 from ..solver.linear import get_solver
 from ..solver.newton import NewtonContext, describe_cells
@@ -225,7 +226,10 @@ def erect(
         if inverted.size:
             reason = f"the start turns {describe_cells(inverted)} over"
     if reason is None:
-        x, path, reason = follow_plan(problem, x, None, _ATTEMPTS, ctx, damping=1.0)
+        try:
+            x, path, reason = follow_plan(problem, x, None, _ATTEMPTS, ctx, damping=1.0)
+        except WrinklingError as exc:
+            reason = str(exc)
     normals, node_areas = node_normals(mesh)
     return ErectionResult(
         mesh=mesh,

@@ -29,7 +29,7 @@ from .assembly import Connectivity
 from .forward import ReferenceBlock, forward_block, forward_projected_hessian, reference_block
 from .loads import cable_terms, pressure_terms
 from .problem import first_positive_root
-from .wrinkling import relaxed_response
+from .wrinkling import WrinklingError, relaxed_response
 
 __all__ = ["Cables", "ErectionEvaluation", "ErectionProblem", "MembraneBlock", "membrane_block"]
 
@@ -210,10 +210,13 @@ class ErectionProblem:
         return out
 
     def energy(self, x: np.ndarray) -> float:
-        """Energy at ``x``; ``inf`` where a cell turns over."""
+        """Energy at ``x``; ``inf`` where a cell turns over (or a wrinkled state is not found)."""
         if self.inverted_cells(x).size:
             return float("inf")
-        return self.evaluate(x, order=0).energy
+        try:
+            return self.evaluate(x, order=0).energy
+        except WrinklingError:
+            return float("inf")
 
     # ------------------------------------------------------------------ admissibility
     def _tangent_jacobians(self, block: MembraneBlock, x: np.ndarray) -> np.ndarray:

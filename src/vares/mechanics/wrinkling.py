@@ -40,7 +40,15 @@ import numpy as np
 
 from ..materials import Fibres, Hyperelastic
 
-__all__ = ["SLACK", "STATES", "TAUT", "WRINKLED", "RelaxedResponse", "relaxed_response"]
+__all__ = [
+    "SLACK",
+    "STATES",
+    "TAUT",
+    "WRINKLED",
+    "RelaxedResponse",
+    "WrinklingError",
+    "relaxed_response",
+]
 
 #: Per-point states.
 TAUT, WRINKLED, SLACK = 0, 1, 2
@@ -54,6 +62,10 @@ ACROSS_TOLERANCE = 1e-13
 _NEWTON_STEPS = 60
 #: Directions, evenly spaced over 180°, from which the search for a wrinkled state may start.
 _START_DIRECTIONS = 12
+
+
+class WrinklingError(RuntimeError):
+    """The wrinkled state of some point was not found."""
 
 
 @dataclass(frozen=True)
@@ -164,12 +176,13 @@ def _wrinkled_states(material, C, stress, fibres, tangent):
             break
         hessian = _hessian_of_f(response.stress[open_], response.tangent[open_], v[open_])
         lowest = np.linalg.eigvalsh(hessian)[:, 0]
-        shift = np.maximum(0.0, 1e-3 * np.abs(hessian).max(axis=(1, 2)) - lowest)
+        # not positive definite (far from the solution): shift to a descent direction
+        shift = np.where(lowest > 0, 0.0, 1e-3 * np.abs(hessian).max(axis=(1, 2)) - lowest)
         step = -np.linalg.solve(
             hessian + shift[:, None, None] * np.eye(2), gradient[open_][..., None]
         )[..., 0]
         # far from the solution, steps that do not lower f are backtracked
-        far = (np.linalg.norm(step, axis=-1) > 1e-6 * length[open_]) | (shift > 0)
+        far = (np.linalg.norm(step, axis=-1) > 1e-3 * length[open_]) | (shift > 0)
         trial = v[open_] + step
         if far.any():
             trial[far] = _backtracked(
@@ -185,7 +198,7 @@ def _wrinkled_states(material, C, stress, fibres, tangent):
     else:
         worst = float((np.linalg.norm(gradient, axis=-1) / length).max())
         if worst > 1e3 * limit:
-            raise RuntimeError(
+            raise WrinklingError(
                 f"the wrinkled state was not found: stress across the wrinkles {worst:.3g}"
             )
     response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres, tangent=tangent)
@@ -231,7 +244,7 @@ def _backtracked(material, C, fibres, v, step, energy, gradient):
     for _ in range(30):
         trial = v + alpha[:, None] * step
         value = material.energy_density(C + np.einsum("pi,pj->pij", trial, trial), fibres)
-        worse = (value > energy + 1e-15 * np.abs(energy)) & (alpha > 0)
+        worse = (value > energy + 1e-12 * np.abs(energy)) & (alpha > 0)
         if not worse.any():
             return trial
         alpha[worse] *= 0.5
