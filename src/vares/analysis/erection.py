@@ -281,7 +281,7 @@ def _context(problem: ErectionProblem, held, solver: SolveOptions, callback) -> 
     material = problem.material
     return NewtonContext(
         assembler=Assembler(problem.connectivity, np.repeat(~held, 3), dofs_per_node=3),
-        linear_solver=get_solver(solver.linear_solver),
+        linear_solver=get_solver(solver.linear_solver, diagonal_pivoting=True),
         residual_tolerance=solver.tolerance * problem.force_scale,
         energy_noise=ENERGY_NOISE
         * material.stiffness_scale

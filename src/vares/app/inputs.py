@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.erection_model import Pattern
-from ..geometry.examples import EXAMPLES, STRUCTURE_EXAMPLES
+from ..geometry.examples import EXAMPLES, PANEL_NAMES, STRUCTURE_EXAMPLES
 from ..geometry.mesh import MeshError
 from ..io.meshes import read_mesh, read_mesh_data, read_pattern
 from ..io.rhino import read_3dm
@@ -57,7 +57,9 @@ def _example(job: Job) -> Input:
             f"{', '.join(STRUCTURE_EXAMPLES)}"
         )
     mesh, ids = STRUCTURE_EXAMPLES[name](cell_type=cell_type)
-    return Input(split_panels(mesh, ids, {int(i): f"strip-{int(i) + 1}" for i in np.unique(ids)}))
+    prefix = PANEL_NAMES.get(name, "panel")
+    names = {int(i): f"{prefix}-{int(i) + 1}" for i in np.unique(ids)}
+    return Input(split_panels(mesh, ids, names))
 
 
 def _structure_panels(job: Job) -> list[Panel]:

@@ -223,7 +223,7 @@ class ErectionProblem:
         """``P j`` ``(m, c, 2, 2)``: the erected cell's Jacobian in the design tangent frame at
         the check points; its determinant is positive while the cell keeps its orientation."""
         j = block.element.jacobians(x, block.cells, at="check")
-        return np.einsum("mcki,mcia->mcka", block.frames, j)
+        return block.frames @ j
 
     def inverted_cells(self, x: np.ndarray) -> np.ndarray:
         """Global (welded) ids of the cells that turned over against the design surface."""

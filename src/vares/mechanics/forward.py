@@ -71,7 +71,7 @@ def forward_block(
     dtype = np.result_type(nodes, reference.gradients)
     gradients = reference.gradients.astype(dtype, copy=False)
     F = _deformation(np.ascontiguousarray(nodes, dtype=dtype), gradients)
-    C = np.einsum("mqia,mqib->mqab", F, F)
+    C = np.swapaxes(F, -1, -2) @ F
     psi, S, tangent = response(C, order >= 2)
     weights = reference.weights.astype(dtype, copy=False)
     energy = np.sum(weights * psi, axis=1)
