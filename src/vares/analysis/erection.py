@@ -39,6 +39,10 @@ __all__ = ["ErectionResult", "Pattern", "erect"]
 
 #: Energy changes below this fraction of stiffness × thickness × area are round-off.
 ENERGY_NOISE = 1e-13
+#: A Newton stall counts as the round-off floor only below this relative residual: where cells
+#: switch between taut, wrinkled and slack, Newton's method may stall well above round-off, and
+#: that is no convergence.
+ROUND_OFF_REGIME = 1e-11
 _ATTEMPTS = (Attempt("erection", None, "line-search"), Attempt("erection, damped", None, "damped"))
 
 
@@ -292,6 +296,7 @@ def _context(problem: ErectionProblem, held, solver: SolveOptions, callback) -> 
         history=[],
         steps=[],
         callback=callback,
+        round_off_regime=ROUND_OFF_REGIME,
     )
 
 

@@ -55,11 +55,12 @@ class ErectionOptions(Options):
         positive=True,
     )
     regularisation: float = option(
-        1e-8,
+        1e-6,
         "float",
-        "Stiffness of a fictitious isotropic tension (relative to the material's) added to the "
-        "Newton tangent only: keeps it regular where the membrane is slack or wrinkled without "
-        "changing the solution.",
+        "Fictitious isotropic tension in every cell, relative to the material's stiffness: slack "
+        "regions hang taut at it instead of having no determinate shape, and Newton's method "
+        "converges through wrinkling; not part of the reported forces (0 for a structure "
+        "without prestress).",
         section="erection",
         minimum=0,
     )

@@ -408,11 +408,11 @@ def hypar_strips(
 
 
 def catenoid_band(
-    panels: int = 8,
-    waist: float = 2.0,
+    panels: int = 12,
+    waist: float = 3.0,
     height: float = 3.0,
     n_along: int = 16,
-    n_around: int = 6,
+    n_around: int = 4,
     cell_type: str = "triangle",
 ) -> tuple[SurfaceMesh, np.ndarray]:
     """A whole catenoid band (a minimal surface between two rings: waist radius ``waist``,

@@ -54,20 +54,12 @@ def reference_block(
 
 
 def forward_block(
-    reference: ReferenceBlock,
-    nodes: np.ndarray,
-    response: Response,
-    order: int = 2,
-    shift: float = 0.0,
+    reference: ReferenceBlock, nodes: np.ndarray, response: Response, order: int = 2
 ) -> BlockResult:
     """Energy ``(m,)``, gradient ``(m, nen, 3)`` and Hessian ``(m, nen, 3, nen, 3)`` (by
     ``order``) of a block whose erected node positions are ``nodes`` ``(m, nen, 3)``;
     ``jacobian_hessian`` holds ``∂²W/∂F²`` ``(m, q, 6, 6)`` per unit weight (index ``2 i + α``
-    for ``F_iα``).
-
-    ``shift`` (stress units) is added to ``S`` in the Hessian only: the Hessian becomes that of
-    the energy plus ``shift (tr C − 2)/2`` (a fictitious isotropic tension, positive definite in
-    every direction), while the energy and gradient stay those of the law."""
+    for ``F_iα``)."""
     dtype = np.result_type(nodes, reference.gradients)
     gradients = reference.gradients.astype(dtype, copy=False)
     F = _deformation(np.ascontiguousarray(nodes, dtype=dtype), gradients)
@@ -86,7 +78,6 @@ def forward_block(
         gradients,
         weights,
         order >= 2,
-        shift,
     )
     if order < 2:
         return BlockResult(energy, gradient, None)
@@ -119,9 +110,8 @@ def _deformation(nodes, gradients):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _derivatives(F, S, tangent, gradients, weights, with_hessian, shift):  # pragma: no cover
-    """Nodal gradient ``Σ_q w F S ∇N_a`` and ``∂²W/∂F²`` per unit weight at each point (with
-    ``S + shift I`` in its geometric term)."""
+def _derivatives(F, S, tangent, gradients, weights, with_hessian):  # pragma: no cover
+    """Nodal gradient ``Σ_q w F S ∇N_a`` and ``∂²W/∂F²`` per unit weight at each point."""
     m, nq, nen = gradients.shape[0], gradients.shape[1], gradients.shape[2]
     dtype = F.dtype
     gradient = np.zeros((m, nen, 3), dtype)
@@ -147,9 +137,7 @@ def _derivatives(F, S, tangent, gradients, weights, with_hessian, shift):  # pra
                 for b in range(2):
                     for k in range(3):
                         for d in range(2):
-                            value = 0.0 * s[b, d]
-                            if i == k:
-                                value += s[b, d] + (shift if b == d else 0.0)
+                            value = s[b, d] if i == k else 0.0 * s[b, d]
                             for a in range(2):
                                 for c in range(2):
                                     value += f[i, a] * cc[a, b, c, d] * f[k, c]

@@ -60,8 +60,12 @@ STATE_TOLERANCE = 1e-12
 #: A wrinkled state is found when the stress across the wrinkles is below this × the stiffness.
 ACROSS_TOLERANCE = 1e-13
 _NEWTON_STEPS = 60
-#: Directions, evenly spaced over 180°, from which the search for a wrinkled state may start.
-_START_DIRECTIONS = 12
+#: Directions on which the wrinkling direction is bracketed: offsets (radians) from the most
+#: compressive stress direction over 180°, geometrically finer towards it (where the stress is
+#: barely compressive, only directions very close to it relax it).
+_OFFSETS = np.pi * np.concatenate(
+    [-np.geomspace(0.5, 1e-6, 20), [0.0], np.geomspace(1e-6, 0.5, 20)]
+)
 
 
 class WrinklingError(RuntimeError):
@@ -157,95 +161,107 @@ def _relaxed_tangent(stress: np.ndarray, cc: np.ndarray, v: np.ndarray) -> np.nd
 
 
 def _wrinkled_states(material, C, stress, fibres, tangent):
-    """The wrinkle ``v`` ``(k, 2)`` minimising ``Ψ(C + v vᵀ)`` and the response there.
+    """The wrinkle ``v = √β n`` ``(k, 2)`` minimising ``f(v) = Ψ(C + v vᵀ)`` and the response
+    there.
 
-    Start: the best of :data:`_START_DIRECTIONS` directions (and that of the most compressive
-    stress), each with the amplitude that minimises ``f`` along it; then Newton's method in ``v``
-    (its Hessian shifted where not positive definite, steps backtracked on ``f`` far from the
-    solution) until the stress across the wrinkle, ``|S(C + v vᵀ) v| / |v|``, is round-off
-    (:data:`ACROSS_TOLERANCE` × the law's stiffness).
+    Along a direction ``n(θ)``, the least ``f`` is where the stress across ``n`` vanishes: a
+    one-dimensional Newton iteration gives that ``β(θ)`` (the stress across grows with β). The
+    least of these over ``θ`` is where the shear ``t(θ) = n⊥·S n`` turns from negative to
+    positive (``d f/dθ = β t``): bracketed on the angles :data:`_OFFSETS` about the most
+    compressive direction, the lowest such bracket is refined by the Illinois method until
+    ``|t|`` is round-off (:data:`ACROSS_TOLERANCE` × the law's stiffness). Only roots are sought,
+    never energy decreases, so states whose energy differences are below round-off are found as
+    well.
     """
     limit = ACROSS_TOLERANCE * material.stiffness_scale
-    v = _start(material, C, stress, fibres, limit)
+    k = len(C)
+    _, compressive = _smallest_eigenpair(stress)
+    grid = np.arctan2(compressive[:, 1], compressive[:, 0])[:, None] + _OFFSETS  # (k, count)
+    count = grid.shape[1]
+    beta, shear, psi = _across(material, np.repeat(C, count, axis=0), grid.ravel(), fibres, limit)
+    beta, shear, psi = (a.reshape(k, count) for a in (beta, shear, psi))
+    # brackets [θ_j, θ_j+1] with t(θ_j) < 0 ≤ t(θ_j+1) and β > 0 at both ends
+    valid = (beta[:, :-1] > 0) & (beta[:, 1:] > 0) & (shear[:, :-1] < 0) & (shear[:, 1:] >= 0)
+    if not valid.any(axis=1).all():
+        raise WrinklingError("the wrinkled state was not found: no direction relaxes the stress")
+    lowest = np.where(valid, np.minimum(psi[:, :-1], psi[:, 1:]), np.inf)
+    j = np.argmin(lowest, axis=1)
+    rows = np.arange(k)
+    a, b = grid[rows, j], grid[rows, j + 1]
+    fa, fb = shear[rows, j], shear[rows, j + 1]
+    beta_b = beta[rows, j + 1]
     for _ in range(_NEWTON_STEPS):
-        response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres)
-        gradient = np.einsum("pij,pj->pi", response.stress, v)
-        length = np.linalg.norm(v, axis=-1)
-        open_ = np.linalg.norm(gradient, axis=-1) > limit * length
+        open_ = np.abs(fb) > limit
         if not open_.any():
             break
-        hessian = _hessian_of_f(response.stress[open_], response.tangent[open_], v[open_])
-        lowest = np.linalg.eigvalsh(hessian)[:, 0]
-        # not positive definite (far from the solution): shift to a descent direction
-        shift = np.where(lowest > 0, 0.0, 1e-3 * np.abs(hessian).max(axis=(1, 2)) - lowest)
-        step = -np.linalg.solve(
-            hessian + shift[:, None, None] * np.eye(2), gradient[open_][..., None]
-        )[..., 0]
-        # far from the solution, steps that do not lower f are backtracked
-        far = (np.linalg.norm(step, axis=-1) > 1e-3 * length[open_]) | (shift > 0)
-        trial = v[open_] + step
-        if far.any():
-            trial[far] = _backtracked(
-                material,
-                C[open_][far],
-                fibres,
-                v[open_][far],
-                step[far],
-                response.psi[open_][far],
-                gradient[open_][far],
-            )
-        v[open_] = trial
+        c = np.where(open_, (a * fb - b * fa) / np.where(fb != fa, fb - fa, 1.0), b)
+        c = np.where((c > np.minimum(a, b)) & (c < np.maximum(a, b)), c, 0.5 * (a + b))
+        beta_c, fc, _ = _across(material, C[open_], c[open_], fibres, limit, beta_b[open_])
+        fc_all = fb.copy()
+        fc_all[open_] = fc
+        flip = open_ & (fc_all * fb < 0)
+        keep = open_ & ~flip
+        a = np.where(flip, b, a)
+        fa = np.where(flip, fb, np.where(keep, 0.5 * fa, fa))  # Illinois
+        b = np.where(open_, c, b)
+        fb = fc_all
+        beta_b[open_] = beta_c
     else:
-        worst = float((np.linalg.norm(gradient, axis=-1) / length).max())
+        worst = float(np.abs(fb).max())
         if worst > 1e3 * limit:
             raise WrinklingError(
-                f"the wrinkled state was not found: stress across the wrinkles {worst:.3g}"
+                f"the wrinkled state was not found: shear across the wrinkles {worst:.3g}"
             )
+    v = _polished(
+        material, C, fibres, np.sqrt(beta_b)[:, None] * np.stack([np.cos(b), np.sin(b)], -1)
+    )
     response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres, tangent=tangent)
     return v, response
 
 
-def _start(material, C, stress, fibres, limit):
-    """For each point the best start ``v = √β n``: over the candidate directions ``n``, the
-    amplitude ``β`` minimising ``f`` along ``n`` (one-dimensional Newton), the lowest ``f``."""
-    k = len(C)
-    angles = np.linspace(0.0, np.pi, _START_DIRECTIONS, endpoint=False)
-    fixed = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
-    _, compressive = _smallest_eigenpair(stress)
-    directions = np.concatenate(
-        [compressive[:, None], np.broadcast_to(fixed, (k, *fixed.shape))], 1
-    )
-    count = directions.shape[1]
-    n = directions.reshape(-1, 2)
-    Cn = np.repeat(C, count, axis=0)
+def _polished(material, C, fibres, v):
+    """Two Newton steps on ``∇f(v) = S(C + v vᵀ) v = 0`` where its Hessian is positive definite,
+    each kept only where it makes ``|∇f|`` smaller: from the bracketed solution they take it to
+    round-off (the exact tangent needs that accuracy)."""
+    response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres)
+    gradient = np.einsum("pij,pj->pi", response.stress, v)
+    for _ in range(2):
+        hessian = _hessian_of_f(response.stress, response.tangent, v)
+        usable = np.linalg.eigvalsh(hessian)[:, 0] > 0
+        if not usable.any():
+            break
+        trial = v.copy()
+        trial[usable] -= np.linalg.solve(hessian[usable], gradient[usable][..., None])[..., 0]
+        moved = material.response(C + np.einsum("pi,pj->pij", trial, trial), fibres)
+        moved_gradient = np.einsum("pij,pj->pi", moved.stress, trial)
+        better = usable & (
+            np.linalg.norm(moved_gradient, axis=-1) < np.linalg.norm(gradient, axis=-1)
+        )
+        v = np.where(better[:, None], trial, v)
+        gradient = np.where(better[:, None], moved_gradient, gradient)
+        stress = np.where(better[:, None, None], moved.stress, response.stress)
+        tangent = np.where(better[:, None, None, None, None], moved.tangent, response.tangent)
+        response = type(response)(response.psi, stress, tangent)
+    return v
+
+
+def _across(material, C, theta, fibres, limit, beta=None):
+    """For directions ``n = (cos θ, sin θ)``: the amplitude ``β ≥ 0`` at which the stress across
+    ``n`` of ``C + β n nᵀ`` vanishes (0 where it is not compressive at β = 0), the shear
+    ``n⊥·S n`` and ``Ψ`` there (one-dimensional Newton from ``beta``)."""
+    n = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
     outer = np.einsum("pi,pj->pij", n, n)
-    beta = np.zeros(len(n))
+    beta = np.zeros(len(n)) if beta is None else np.array(beta, dtype=float)
     for _ in range(_NEWTON_STEPS):
-        response = material.response(Cn + beta[:, None, None] * outer, fibres)
+        response = material.response(C + beta[:, None, None] * outer, fibres)
         across = np.einsum("pi,pij,pj->p", n, response.stress, n)
-        slope = 0.5 * np.einsum("pij,pijkl,pkl->p", outer, response.tangent, outer)
-        # f decreases along n while the stress across it is compressive; stop where it is not
         moving = (across < -limit) | ((beta > 0) & (np.abs(across) > limit))
         if not moving.any():
             break
+        slope = 0.5 * np.einsum("pij,pijkl,pkl->p", outer, response.tangent, outer)
         change = np.where(moving & (slope > 0), -across / np.where(slope > 0, slope, 1.0), 0.0)
         beta = np.maximum(beta + change, 0.1 * beta)
-    energy = material.energy_density(Cn + beta[:, None, None] * outer, fibres).reshape(k, count)
-    best = np.argmin(energy, axis=1)
-    chosen = np.arange(k) * count + best
-    return np.sqrt(beta[chosen])[:, None] * n[chosen]
-
-
-def _backtracked(material, C, fibres, v, step, energy, gradient):
-    """``v + α step`` with ``α`` halved until ``f`` does not increase (per point)."""
-    alpha = np.ones(len(v))
-    descent = np.einsum("pi,pi->p", gradient, step) < 0
-    alpha[~descent] = 0.0  # no descent direction: this point has converged to round-off
-    for _ in range(30):
-        trial = v + alpha[:, None] * step
-        value = material.energy_density(C + np.einsum("pi,pj->pij", trial, trial), fibres)
-        worse = (value > energy + 1e-12 * np.abs(energy)) & (alpha > 0)
-        if not worse.any():
-            return trial
-        alpha[worse] *= 0.5
-    return v + alpha[:, None] * step
+    response = material.response(C + beta[:, None, None] * outer, fibres, tangent=False)
+    normal = np.stack([-n[:, 1], n[:, 0]], axis=-1)
+    shear = np.einsum("pi,pij,pj->p", normal, response.stress, n)
+    return beta, shear, np.broadcast_to(response.psi, beta.shape)
