@@ -145,17 +145,26 @@ class ErectionProblem:
             cells["cables"] = cables.segments
         self.connectivity = Connectivity(len(self.design_points), cells)
         self.reference_area = float(sum(b.reference.weights.sum() for b in blocks)) / thickness
+        self._wrinkles: dict[int, np.ndarray] = {}  # per block: the wrinkles last found
 
     # ------------------------------------------------------------------ the energy
-    def response(self, fibres: Fibres | None, relaxed: bool | None = None):
+    def response(
+        self, fibres: Fibres | None, relaxed: bool | None = None, block: int | None = None
+    ):
         """The response function of :func:`vares.mechanics.forward.forward_block`: the relaxed
-        (or plain) law and the regularising tension."""
+        (or plain) law and the regularising tension. With ``block``, the wrinkles found at the
+        block's last evaluation are the start of the next (Newton's iterates move little)."""
         relaxed = self.wrinkling if relaxed is None else relaxed
         tension = self.tension
 
         def respond(C, tangent):
             if relaxed and np.isrealobj(C):
-                r = relaxed_response(self.material, C, fibres, tangent=tangent)
+                guess = self._wrinkles.get(block)
+                if guess is not None and guess.shape != C.shape[:-1]:
+                    guess = None
+                r = relaxed_response(self.material, C, fibres, tangent=tangent, guess=guess)
+                if block is not None:
+                    self._wrinkles[block] = r.wrinkle
             else:
                 r = self.material.response(C, fibres, tangent=tangent)
             psi = r.psi + 0.5 * tension * (C[..., 0, 0] + C[..., 1, 1] - 2.0)
@@ -168,9 +177,10 @@ class ErectionProblem:
         positions ``x`` ``(n, 3)``."""
         energies, gradients, hessians, jacobian_hessians = [], [], [], []
         total = 0.0
-        for block in self.blocks:
+        for index, block in enumerate(self.blocks):
             nodes = x[block.cells]
-            result = forward_block(block.reference, nodes, self.response(block.fibres), order)
+            respond = self.response(block.fibres, block=index)
+            result = forward_block(block.reference, nodes, respond, order)
             energies.append(result.energy)
             total += np.sum(result.energy).real
             gradient, hessian = result.gradient, result.hessian

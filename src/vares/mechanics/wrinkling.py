@@ -112,10 +112,17 @@ def _largest_eigenvalue(A: np.ndarray) -> np.ndarray:
 
 
 def relaxed_response(
-    material: Hyperelastic, C: np.ndarray, fibres: Fibres | None = None, *, tangent: bool = True
+    material: Hyperelastic,
+    C: np.ndarray,
+    fibres: Fibres | None = None,
+    *,
+    tangent: bool = True,
+    guess: np.ndarray | None = None,
 ) -> RelaxedResponse:
     """Relaxed energy, stress and (optionally) tangent of ``material`` at ``C`` ``(..., 2, 2)``
-    (real arithmetic; module docs)."""
+    (real arithmetic; module docs). ``guess`` ``(..., 2)``: wrinkles ``v`` of nearby states (a
+    previous Newton iterate's) to start from; where Newton's method from them does not reach
+    the wrinkled state, it is searched for as without."""
     shape = C.shape[:-2]
     flat = np.ascontiguousarray(C.reshape(-1, 2, 2), dtype=float)
     full = material.response(flat, fibres, tangent=tangent)
@@ -134,7 +141,10 @@ def relaxed_response(
         cc[slack] = 0.0
     wrinkle = np.zeros((flat.shape[0], 2))
     if wrinkled.any():
-        v, relaxed = _wrinkled_states(material, flat[wrinkled], stress[wrinkled], fibres, tangent)
+        start = None if guess is None else np.asarray(guess).reshape(-1, 2)[wrinkled]
+        v, relaxed = _wrinkled_states(
+            material, flat[wrinkled], stress[wrinkled], fibres, tangent, start
+        )
         wrinkle[wrinkled] = v
         psi[wrinkled], stress[wrinkled] = relaxed.psi, relaxed.stress
         if cc is not None:
@@ -160,7 +170,7 @@ def _relaxed_tangent(stress: np.ndarray, cc: np.ndarray, v: np.ndarray) -> np.nd
     return cc - np.einsum("pabm,pmi,pcdi->pabcd", T, H_inv, T)
 
 
-def _wrinkled_states(material, C, stress, fibres, tangent):
+def _wrinkled_states(material, C, stress, fibres, tangent, start=None):
     """The wrinkle ``v = √β n`` ``(k, 2)`` minimising ``f(v) = Ψ(C + v vᵀ)`` and the response
     there.
 
@@ -171,9 +181,24 @@ def _wrinkled_states(material, C, stress, fibres, tangent):
     compressive direction, the lowest such bracket is refined by the Illinois method until
     ``|t|`` is round-off (:data:`ACROSS_TOLERANCE` × the law's stiffness). Only roots are sought,
     never energy decreases, so states whose energy differences are below round-off are found as
-    well.
+    well. Points with a ``start`` (non-zero) try Newton's method from it first.
     """
     limit = ACROSS_TOLERANCE * material.stiffness_scale
+    v = np.zeros((len(C), 2))
+    searched = np.ones(len(C), dtype=bool)
+    if start is not None:
+        warm = np.linalg.norm(start, axis=-1) > 0
+        if warm.any():
+            v[warm], found = _polished(material, C[warm], fibres, start[warm], limit, steps=8)
+            searched[np.flatnonzero(warm)[found]] = False
+    if searched.any():
+        v[searched] = _searched(material, C[searched], stress[searched], fibres, limit)
+    response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres, tangent=tangent)
+    return v, response
+
+
+def _searched(material, C, stress, fibres, limit):
+    """The wrinkles ``v`` by bracketing their direction (see :func:`_wrinkled_states`)."""
     k = len(C)
     _, compressive = _smallest_eigenpair(stress)
     grid = np.arctan2(compressive[:, 1], compressive[:, 0])[:, None] + _OFFSETS  # (k, count)
@@ -212,20 +237,18 @@ def _wrinkled_states(material, C, stress, fibres, tangent):
             raise WrinklingError(
                 f"the wrinkled state was not found: shear across the wrinkles {worst:.3g}"
             )
-    v = _polished(
-        material, C, fibres, np.sqrt(beta_b)[:, None] * np.stack([np.cos(b), np.sin(b)], -1)
-    )
-    response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres, tangent=tangent)
-    return v, response
+    v = np.sqrt(beta_b)[:, None] * np.stack([np.cos(b), np.sin(b)], -1)
+    return _polished(material, C, fibres, v, limit, steps=2)[0]
 
 
-def _polished(material, C, fibres, v):
-    """Two Newton steps on ``∇f(v) = S(C + v vᵀ) v = 0`` where its Hessian is positive definite,
-    each kept only where it makes ``|∇f|`` smaller: from the bracketed solution they take it to
-    round-off (the exact tangent needs that accuracy)."""
+def _polished(material, C, fibres, v, limit, steps):
+    """Newton steps on ``∇f(v) = S(C + v vᵀ) v = 0`` where its Hessian is positive definite,
+    each kept only where it makes ``|∇f|`` smaller: from a bracketed solution two take it to
+    round-off (the exact tangent needs that accuracy); from a previous iterate's wrinkle a few
+    find the new one. Returns ``v`` and where ``|∇f| / |v|`` is within ``limit``."""
     response = material.response(C + np.einsum("pi,pj->pij", v, v), fibres)
     gradient = np.einsum("pij,pj->pi", response.stress, v)
-    for _ in range(2):
+    for _ in range(steps):
         hessian = _hessian_of_f(response.stress, response.tangent, v)
         usable = np.linalg.eigvalsh(hessian)[:, 0] > 0
         if not usable.any():
@@ -242,7 +265,9 @@ def _polished(material, C, fibres, v):
         stress = np.where(better[:, None, None], moved.stress, response.stress)
         tangent = np.where(better[:, None, None, None, None], moved.tangent, response.tangent)
         response = type(response)(response.psi, stress, tangent)
-    return v
+    length = np.linalg.norm(v, axis=-1)
+    found = (length > 0) & (np.linalg.norm(gradient, axis=-1) <= limit * length)
+    return v, found
 
 
 def _across(material, C, theta, fibres, limit, beta=None):
