@@ -43,6 +43,10 @@ def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welde
     :class:`MeshError` if the welded surface is not a valid surface (e.g. panels oriented
     oppositely).
     """
+    if len(meshes) == 1:  # nothing to weld: the mesh as it is
+        mesh = meshes[0]
+        ranges = {t: (0, len(c)) for t, c in mesh.cells.items()}
+        return Welded(mesh, [np.arange(mesh.num_points)], [ranges])
     points = np.vstack([m.points for m in meshes])
     offsets = np.cumsum([0] + [m.num_points for m in meshes])
     size = float(np.ptp(points, axis=0).max()) or 1.0

@@ -41,10 +41,10 @@ def erect(
     """Erect the structure from its patterns: weld the panels, stretch them onto the supports
     and solve for the shape and the membrane forces they settle into.
 
-    Reads DIR/job.toml (material, prestress, the [erection] table) and each panel's
+    Reads DIR/job.toml (material, prestress and the job's erection table) and each panel's
     surface.vtu, pattern.vtu and summary.json; writes DIR/erect/: erect.json, erected.vtu,
     erected.obj and drawings (deviation, warp and fill force, wrinkled/slack). Flags override
-    the job's [erection] table.
+    the job's erection table.
     """
 
     def body() -> None:
