@@ -141,6 +141,11 @@ def test_run_with_erect_and_clear_errors(tmp_path):
     assert result.exit_code == 2 and "no job.toml" in error_line(result)
     result = run("erect", tmp_path / "out", "--cable-stiffness", "10", "--pressure", "1", "-f")
     assert result.exit_code == 2 and "not conservative" in error_line(result)
+    result = run("erect", job)
+    assert result.exit_code == 2 and "is a file" in error_line(result)
+    (tmp_path / "out" / "pattern.vtu").write_text("not a mesh\n")  # a damaged output folder
+    result = run("erect", tmp_path / "out", "-f")
+    assert result.exit_code == 2 and "cannot read" in error_line(result)
     bad = tmp_path / "bad.toml"
     bad.write_text('[input]\nexample = "hypar"\n[erection]\npresure = 1.0\n')
     result = run("run", bad, "-q")

@@ -38,13 +38,33 @@ def read_mesh(path: str | Path) -> SurfaceMesh:
     return read_mesh_data(path)[0]
 
 
+def _meshio_read(path: Path):
+    """``meshio.read``, every failure a :class:`MeshError` naming the file."""
+    import meshio
+
+    chatter = io.StringIO()  # some readers print their complaints: keep them for the error
+    try:
+        with (
+            warnings.catch_warnings(),
+            contextlib.redirect_stdout(chatter),
+            contextlib.redirect_stderr(chatter),
+        ):
+            warnings.simplefilter("ignore")
+            return meshio.read(path)
+    except meshio.ReadError as exc:
+        raise MeshError(f"cannot read {path}: {exc}") from exc
+    except (Exception, SystemExit) as exc:  # a reader may even exit on a broken file
+        detail = chatter.getvalue().strip().splitlines()
+        reason = detail[-1] if detail else f"{type(exc).__name__}: {exc}"
+        raise MeshError(f"cannot read {path}: {reason}") from None
+
+
 def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]]:
     """:func:`read_mesh`, and the file's cell data in the mesh's global cell order.
 
     Each cell data array has shape ``(num_cells,)`` or ``(num_cells, k)``; arrays that exist
     only on some cell blocks are left out.
     """
-    import meshio
 
     path = Path(path)
     if not path.is_file():
@@ -62,22 +82,7 @@ def read_mesh_data(path: str | Path) -> tuple[SurfaceMesh, dict[str, np.ndarray]
                 "('vares panels')"
             )
         return meshes[0].mesh, {}
-    chatter = io.StringIO()  # some readers print their complaints: keep them for the error
-    try:
-        with (
-            warnings.catch_warnings(),
-            contextlib.redirect_stdout(chatter),
-            contextlib.redirect_stderr(chatter),
-        ):
-            warnings.simplefilter("ignore")
-            raw = meshio.read(path)
-    except meshio.ReadError as exc:
-        raise MeshError(f"cannot read {path}: {exc}") from exc
-    except (Exception, SystemExit) as exc:  # a reader may even exit on a broken file
-        detail = chatter.getvalue().strip().splitlines()
-        reason = detail[-1] if detail else f"{type(exc).__name__}: {exc}"
-        raise MeshError(f"cannot read {path}: {reason}") from None
-
+    raw = _meshio_read(path)
     cells: dict[str, list[np.ndarray]] = {}
     data: dict[str, dict[str, list[np.ndarray]]] = {}
     for index, block in enumerate(raw.cells):
@@ -144,15 +149,10 @@ def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
 
     The file must have the same cells as ``mesh`` (same nodes and faces) and lie in z = 0.
     """
-    import meshio
-
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
-    try:
-        raw = meshio.read(path)
-    except Exception as exc:
-        raise MeshError(f"cannot read {path}: {type(exc).__name__}: {exc}") from exc
+    raw = _meshio_read(path)
     cells = {b.type: b.data for b in raw.cells if b.type in mesh.cells}
     same = len(raw.points) == mesh.num_points and all(
         t in cells and np.array_equal(cells[t], c) for t, c in mesh.cells.items()

@@ -48,6 +48,11 @@ def erect(
     """
 
     def body() -> None:
+        if directory.is_file():
+            raise InputError(
+                f"{directory} is a file: give the output directory of 'vares pattern', "
+                "'example', 'run' or 'panels'"
+            )
         if not directory.is_dir():
             raise InputError(f"no such directory: {directory}")
         job_file = directory / JOB_FILE
