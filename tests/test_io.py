@@ -192,6 +192,7 @@ def test_pattern_outputs_drawings_and_report_in_a_browser(tmp_path):
         30,
         "--mark-spacing",
         1000,
+        "--erect",
         "-q",
     )
     assert result.exit_code == 0, result.stderr
@@ -235,8 +236,19 @@ def test_pattern_outputs_drawings_and_report_in_a_browser(tmp_path):
         "figure-det_F",
         "figure-warp_stress",
         "figure-surface-det_F",
+        *(f"figure-erection-{k}" for k in range(6)),
     ):
         assert f'id="{figure}"' in dom
+    # the erection section: design shape against erected, the numbers of erect.json
+    erected = json.loads((out / "erect" / "erect.json").read_text())
+    comparison = dom.split('id="erection-comparison"')[1].split("</table>")[0]
+    assert "<th>on the design shape</th><th>after erection</th>" in comparison
+    design, mean = (
+        erected["design_shape"]["stress"]["warp"]["mean"],
+        erected["stress"]["warp"]["mean"],
+    )
+    row = f'<th>warp: mean</th><td class="num">{design:.5g}</td><td class="num">{mean:.5g}</td>'
+    assert row in comparison
     screenshot = tmp_path / "report.png"
     subprocess.run(
         [

@@ -323,7 +323,7 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
     single = _cli("pattern", source, "-o", tmp_path / "single", "--plot", "det_F", "-q")
     assert single.exit_code == 0, single.stderr
     expected = {p.name for p in (tmp_path / "single").iterdir()} | {"surface.obj", "report.html"}
-    expected -= {".vares-run.json"}  # the manifest of a run is in its output folder only
+    expected -= {".vares-run.json", "job.toml"}  # a run's manifest and job: in its folder only
     names = ["panel-0", "panel-1"]
     for name in names:
         assert {p.name for p in (out / name).iterdir()} == expected
@@ -333,6 +333,7 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
         "structure.dxf",
         "report.html",
         ".vares-run.json",
+        "job.toml",
     }
     report = (out / "report.html").read_text()
     assert all(f'href="{name}/report.html"' in report for name in names)

@@ -2,13 +2,17 @@ import numpy as np
 import pytest
 
 import vares
+from vares.analysis.erection_fields import CELL_FIELDS
 from vares.geometry.examples import hypar
 from vares.io.plot import FIELD_LABELS, plot_pattern, save_pattern_figure
 from vares.mechanics.fields import FIELD_DESCRIPTIONS
 
 
 def test_every_field_has_a_colour_bar_label():
-    assert set(FIELD_LABELS) == set(FIELD_DESCRIPTIONS)
+    """Every per-cell field of a pattern and of an erection (and the erection's per-node
+    deviation, drawn per cell) has a label, and nothing else does."""
+    erection = set(CELL_FIELDS) | {"normal_deviation"}
+    assert set(FIELD_LABELS) == set(FIELD_DESCRIPTIONS) | erection
 
 
 @pytest.mark.parametrize("suffix", [".png", ".svg"])

@@ -15,7 +15,15 @@ The package is layered along the data path (docs/architecture.md): ``materials``
 
 from . import materials
 from ._version import __version__
-from .analysis import PatternEvaluation, cell_fields, compensation_report, evaluate
+from .analysis import (
+    ErectionOptions,
+    ErectionResult,
+    PatternEvaluation,
+    cell_fields,
+    compensation_report,
+    erect,
+    evaluate,
+)
 from .geometry import MeshError, ProjectionPlane, SurfaceMesh, examples, projection_plane
 from .io import read_mesh, read_mesh_data
 from .materials import Fibres
@@ -37,6 +45,8 @@ from .structures import (
 __all__ = [
     "CutOptions",
     "CutResult",
+    "ErectionOptions",
+    "ErectionResult",
     "Fibres",
     "IterationRecord",
     "MeshError",
@@ -55,6 +65,7 @@ __all__ = [
     "cell_fields",
     "compensation_report",
     "cut",
+    "erect",
     "evaluate",
     "examples",
     "find_seams",

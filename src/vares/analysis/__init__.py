@@ -1,19 +1,27 @@
-"""What a pattern does: per-cell results of any pattern, the compensation report, statistics."""
+"""What a pattern does: per-cell results of any pattern, the compensation report, statistics,
+and the erection analysis (the structure built from its patterns)."""
 
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
 from .checks import pattern_warnings
 from .compensation import CompensationReport, YarnReport, compensation_report
+from .erection import ErectionResult, erect
+from .erection_model import Pattern
 from .evaluate import PatternEvaluation, evaluate
+from .options import ErectionOptions
 from .statistics import field_statistics
 
 __all__ = [
     "FIELD_DESCRIPTIONS",
     "KEY_FIELDS",
     "CompensationReport",
+    "ErectionOptions",
+    "ErectionResult",
+    "Pattern",
     "PatternEvaluation",
     "YarnReport",
     "cell_fields",
     "compensation_report",
+    "erect",
     "evaluate",
     "field_statistics",
     "pattern_warnings",

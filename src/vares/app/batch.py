@@ -50,9 +50,18 @@ def _previous(job: Job) -> dict:
 
 
 def is_complete(job: Job) -> bool:
-    """True when the job's outputs exist, converged, and were written for this very job."""
+    """True when the job's outputs exist, converged, and were written for this very job (and,
+    with an erection, its ``erect.json`` says it converged)."""
     data = _previous(job)
-    return bool(data.get("converged")) and data.get("job_digest") == job.digest()
+    if not (data.get("converged") and data.get("job_digest") == job.digest()):
+        return False
+    if job.erection is None:
+        return True
+    try:
+        erected = json.loads((job.directory / "erect" / "erect.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return bool(erected.get("converged"))
 
 
 def _refuse_shared_outputs(paths: list[str]) -> None:

@@ -1,21 +1,26 @@
 """Reading a job's input: one surface, or the panels of a structure — repaired, in known units,
-with what was changed or is doubtful said aloud."""
+with what was changed or is doubtful said aloud; and reading back the patterns a job wrote (for
+``vares erect DIR``)."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, STRUCTURE_EXAMPLES
+from ..analysis.erection_model import Pattern
+from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, PANEL_NAMES, STRUCTURE_EXAMPLES
 from ..geometry.mesh import MeshError
-from ..io.meshes import MeshFile, read_mesh_file, read_pattern
+from ..io.meshes import MeshFile, read_mesh, read_mesh_data, read_mesh_file, read_pattern
 from ..io.rhino import read_3dm, unit_system
+from ..materials import Fibres
 from ..structures.panels import Panel, split_panels
 from ..units import implausible_size
 from .job import Job, JobError
 
-__all__ = ["DEFAULT_UNITS", "Input", "load_input"]
+__all__ = ["DEFAULT_UNITS", "Input", "load_input", "safe_name", "saved_patterns"]
 
 #: Units of coordinates when neither the file nor the job names any.
 DEFAULT_UNITS = "m"
@@ -108,7 +113,8 @@ def _example(job: Job) -> Input:
             f"{', '.join(STRUCTURE_EXAMPLES)}"
         )
     mesh, ids = STRUCTURE_EXAMPLES[name](cell_type=cell_type)
-    names = {int(i): f"strip-{int(i) + 1}" for i in np.unique(ids)}
+    prefix = PANEL_NAMES.get(name, "panel")
+    names = {int(i): f"{prefix}-{int(i) + 1}" for i in np.unique(ids)}
     return Input(split_panels(mesh, ids, names), units)
 
 
@@ -151,3 +157,44 @@ def _split(job: Job, mesh_file: MeshFile) -> list[Panel]:
             f"(it has: {', '.join(mesh_file.cell_data) or 'none'})"
         )
     return [Panel(f"{mesh_file.path.stem}-{k + 1}", mesh) for k, (mesh, _) in enumerate(pieces)]
+
+
+def _read_json(path: Path) -> dict:
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path} (is this an output directory of vares?)")
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except ValueError as exc:
+        raise JobError(f"{path}: not valid JSON: {exc}") from None
+
+
+def saved_patterns(job: Job) -> list[Pattern]:
+    """The patterns a job wrote into its output directory, one per panel: the surface and the
+    pattern from ``surface.vtu`` and ``pattern.vtu``, the fibres from ``summary.json``, the
+    prestress from the job (a per-cell prestress field is read from the input file)."""
+    directory = job.directory
+    if job.structure is None:
+        folders = [directory]
+    else:
+        names = [p["name"] for p in _read_json(directory / "structure.json")["panels"]]
+        folders = [directory / safe_name(name) for name in names]
+    cell_data = {}
+    if job.prestress.field is not None:
+        _, cell_data = read_mesh_data(job.path(job.input.mesh))
+    patterns = []
+    for folder in folders:
+        summary = _read_json(folder / "summary.json")
+        name = summary.get("name") or folder.name
+        if not summary.get("converged"):
+            raise JobError(f"{name}: the pattern did not converge ({summary.get('reason')})")
+        mesh = read_mesh(folder / "surface.vtu")
+        coordinates = read_pattern(folder / "pattern.vtu", mesh)
+        fibres = Fibres(*(np.asarray(summary["fibres"][k], dtype=float) for k in ("warp", "fill")))
+        prestress = job.prestress.value(cell_data)
+        patterns.append(Pattern(mesh, coordinates, fibres, prestress, name))
+    return patterns
+
+
+def safe_name(name: str) -> str:
+    """A panel name as a folder name (letters, digits, ``-_.``)."""
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "panel"

@@ -32,6 +32,10 @@ in :mod:`vares.options`); an unknown table or key is an error naming the closest
     [structure]                  # present: the input is a structure of several panels
     match_seams = true
 
+    [erection]                   # present: erect the structure from its patterns afterwards
+    wrinkling = true
+    pressure = 0.0
+
     [cut]                        # present: cut the surface into strips of roll width
     roll_width = 2.5             # mesh units
     seams = "geodesic"           # or "planar", or "curves" with curves = "lines.3dm"
@@ -49,6 +53,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ..analysis.options import ErectionOptions
 from ..options import Options, OptionsError, Spec
 from ..solver.options import SolveOptions
 from ..structures.options import CutOptions, StructureOptions
@@ -71,13 +76,17 @@ SECTIONS: dict[str, str] = {
     "output": "output",
     "structure": "structure",
     "cut": "cut",
+    "erection": "erection",
 }
+#: Tables whose presence means something even when empty.
+_PRESENCE = ("structure", "cut", "erection")
 
 
 @dataclass(frozen=True)
 class Job:
     """A patterning job: one options object per part; ``structure`` is set for a structure of
-    several panels, ``cut`` (and ``structure``) for a surface cut into strips of roll width.
+    several panels, ``cut`` (and ``structure``) for a surface cut into strips of roll width,
+    ``erection`` when the structure is to be erected from its patterns after patterning.
     ``base`` is the folder relative paths are relative to; ``location`` the job file it was
     read from (if any)."""
 
@@ -88,6 +97,7 @@ class Job:
     output: OutputOptions = field(default_factory=OutputOptions)
     structure: StructureOptions | None = None
     cut: CutOptions | None = None
+    erection: ErectionOptions | None = None
     base: Path = field(default_factory=Path.cwd)
     location: Path | None = None
 
@@ -113,7 +123,7 @@ class Job:
             parts.setdefault(SECTIONS[section], {}).update(values)
         built = {}
         for part, values in parts.items():
-            if part == "structure" or values or part == "input":
+            if part in _PRESENCE or values or part == "input":
                 built[part] = _build(_PARTS[part], values, origin)
         if "input" not in built:
             raise JobError(f"{origin}: [input] needs exactly one of mesh, meshes or example")
@@ -133,7 +143,7 @@ class Job:
             for key, spec in options.specs().items():
                 if key in values and spec.kind in ("path", "paths"):
                     values[key] = _relocated(values[key], self.base, location)
-            if values or section == "structure":
+            if values or section in _PRESENCE:
                 out[section] = values
         return out
 
@@ -176,6 +186,7 @@ _PARTS: dict[str, type[Options]] = {
     "output": OutputOptions,
     "structure": StructureOptions,
     "cut": CutOptions,
+    "erection": ErectionOptions,
 }
 
 

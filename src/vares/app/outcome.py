@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..analysis.compensation import CompensationReport
+from ..analysis.erection import ErectionResult
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..solver.result import PatternResult
@@ -34,8 +35,9 @@ class PanelOutcome:
 @dataclass
 class JobOutcome:
     """What a job produced: one :class:`PanelOutcome` per pattern (one for a single surface),
-    the structure's result for a structure (and the cut's for a cut job), the output folder,
-    the length units, what the input's repair changed, and every file written."""
+    the structure's result for a structure (and the cut's for a cut job), the erection (when
+    asked for), the output folder, the length units, what the input's repair changed, and every
+    file written."""
 
     job: Job
     material: Hyperelastic
@@ -45,20 +47,29 @@ class JobOutcome:
     units: str = "m"
     repairs: dict[str, dict[str, object]] = field(default_factory=dict)
     cut: CutResult | None = None
+    erection: ErectionResult | None = None
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 
     @property
-    def converged(self) -> bool:
+    def patterned(self) -> bool:
+        """The patterns converged (every panel's, and the seam matching)."""
         if self.structure is not None:
             return self.structure.converged
         return self.panels[0].result.converged
 
     @property
+    def converged(self) -> bool:
+        """The patterns converged, and so did the erection when there was one."""
+        return self.patterned and (self.erection is None or self.erection.converged)
+
+    @property
     def reason(self) -> str | None:
-        if self.structure is not None:
-            return self.structure.reason
-        return self.panels[0].result.reason
+        if not self.patterned:
+            return self.structure.reason if self.structure else self.panels[0].result.reason
+        if self.erection is not None and not self.erection.converged:
+            return f"the erection did not converge: {self.erection.reason}"
+        return None
 
     @property
     def result(self) -> PatternResult:

@@ -11,6 +11,10 @@ One pattern (in the output directory; for a structure, in a folder per panel):
 ``surface.obj``                 the 3D surface, for examples and for a structure's panels
 ``report.html``                 with ``report``: everything above for a person, in one file
 
+Every job writes ``job.toml`` into the output directory: the job as it ran (paths relative to
+it), from which ``vares erect DIR`` (and ``vares run DIR/job.toml -o …``) take the input,
+material, fibres and prestress; an erection writes ``erect/`` (:mod:`vares.app.erection_outputs`).
+
 A structure adds ``structure.json`` (panels, seams before and after matching, the energy price,
 the roll width check), ``structure.dxf`` (all patterns with matching marks) and, with ``report``,
 its own ``report.html``. A cut job writes its pieces nested on the roll instead of
@@ -36,12 +40,24 @@ from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
 from ..units import METRES
-from .inputs import Input
+from .erection_outputs import erection_files
+from .inputs import Input, safe_name
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
 from .sections import STRUCTURE_MARK_SPACING
 
-__all__ = ["panel_directory", "planned_files", "safe_name", "write_panel", "write_structure"]
+__all__ = [
+    "JOB_FILE",
+    "panel_directory",
+    "planned_files",
+    "safe_name",
+    "write_job_file",
+    "write_panel",
+    "write_structure",
+]
+
+#: The job as it ran, in the output directory.
+JOB_FILE = "job.toml"
 
 #: The files of a cut job besides the strips' and the structure's (see app/cut_outputs.py).
 CUT_FILES = ("cut.json", "nest.dxf", "nest.svg", "nest.png", "cut_lines.png", "panels.vtu")
@@ -55,11 +71,6 @@ PATTERN_FILES = (
     "pattern.vtu",
     "surface.vtu",
 )
-
-
-def safe_name(name: str) -> str:
-    """A panel name as a folder name (letters, digits, ``-_.``)."""
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "panel"
 
 
 def panel_directory(job: Job, name: str, root: Path | None = None) -> Path:
@@ -91,9 +102,22 @@ def planned_files(job: Job, source: Input, save_job: Path | None = None) -> list
         names = ["structure.json"] + (["report.html"] if job.output.report else [])
         names += list(CUT_FILES) if job.cut is not None else ["structure.dxf"]
         files += [job.directory / n for n in names]
+    files.append(job.directory / JOB_FILE)
+    if job.erection is not None:
+        files += erection_files(job.directory / "erect")
     if save_job is not None and job.directory.resolve() in save_job.resolve().parents:
         files.append(save_job)
     return files
+
+
+def write_job_file(job: Job, directory: Path) -> Path:
+    """``job.toml`` in ``directory`` (the staging folder of the output directory): the job as it
+    ran, paths relative to the output directory."""
+    text = job.to_toml(job.directory / JOB_FILE)
+    path = directory / JOB_FILE
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8")
+    return path
 
 
 def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | None = None) -> None:

@@ -1,38 +1,47 @@
-"""Running a job: read the input, solve (one surface, or a structure's panels), write the files.
+"""Running a job: read the input, solve (one surface, or a structure's panels), erect the
+structure from its patterns if asked, write the files.
 
-The one runner behind ``vares pattern``, ``example``, ``run``, ``panels`` and ``batch``: every
-command builds a :class:`vares.app.job.Job` and hands it here, so they all get the same outputs
-(see :mod:`vares.app.outputs`). Everything that can be checked is checked before the solve; the
-files of a run are staged and put in place as one set (:mod:`vares.app.staging`).
+The one runner behind ``vares pattern``, ``example``, ``run``, ``panels``, ``cut``, ``batch`` and
+``erect``: every command builds a :class:`vares.app.job.Job` and hands it here, so they all get
+the same outputs (see :mod:`vares.app.outputs`). Everything that can be checked is checked before
+the solve; the files of a run are staged and put in place as one set (:mod:`vares.app.staging`).
+:func:`run_erection` erects the patterns an earlier run wrote (``vares erect DIR``).
 """
 
 from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..analysis.checks import pattern_warnings
 from ..analysis.compensation import compensation_report
+from ..analysis.erection import ErectionResult, erect
+from ..analysis.erection_model import Pattern
+from ..analysis.options import ErectionOptions
 from ..geometry.examples import EXAMPLE_PLANES
 from ..geometry.mesh import SurfaceMesh
 from ..io.files import check_writable, write_with
 from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
 from ..structures.matching import solve_structure
-from .inputs import Input, load_input
-from .job import Job, JobError
+from .erection_outputs import erection_files, write_erection
+from .inputs import Input, load_input, saved_patterns
+from .job import Job, JobError, load_job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import (
+    JOB_FILE,
     panel_directory,
     planned_files,
     structure_marks,
+    write_job_file,
     write_panel,
     write_structure,
 )
-from .staging import OutputFolder
+from .staging import OutputFolder, add_to_manifest, listed
 
-__all__ = ["run_job"]
+__all__ = ["ErectionRun", "run_erection", "run_job"]
 
 
 def run_job(
@@ -69,6 +78,8 @@ def run_job(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         outcome = _solve(job, source, material, _options(job), callback)
+        if job.erection is not None:
+            _erect(outcome, _options(job), callback)
     outcome.warnings = source.warnings + [str(w.message) for w in caught] + outcome.warnings
     root = folder.start()
     try:
@@ -89,8 +100,9 @@ def _inputs(job: Job) -> list[Path]:
     for extra in (job.material.presets, job.input.initial_pattern, curves):
         if extra is not None:
             paths.append(job.path(extra))
-    if job.location is not None:
-        paths.append(job.location)
+    own_file = (job.directory / JOB_FILE).resolve()
+    if job.location is not None and job.location.resolve() != own_file:
+        paths.append(job.location)  # a run's own job.toml is rewritten with the same job
     return paths
 
 
@@ -130,6 +142,9 @@ def _write(outcome: JobOutcome, root: Path, save_job: Path | None, folder: Outpu
         from .cut_outputs import write_cut
 
         write_cut(outcome)
+    outcome.files.append(write_job_file(job, root))
+    if outcome.erection is not None:
+        outcome.files += write_erection(outcome.erection, root / "erect", outcome.units)
     if job.output.report:
         from .report import write_reports
 
@@ -156,6 +171,93 @@ def _moved(outcome: JobOutcome, directory: Path, root: Path) -> None:
     for panel in outcome.panels:
         panel.directory = final(panel.directory)
         panel.files = [final(p) for p in panel.files]
+
+
+def _erect(outcome: JobOutcome, options, callback) -> None:
+    """Erect the structure from the job's patterns (patterns that did not converge are not
+    erected: a warning says so)."""
+    job = outcome.job
+    if not outcome.patterned:
+        outcome.warnings.append("not erected: the patterns did not converge")
+        return
+    patterns = [Pattern.of(p.result, p.name) for p in outcome.panels]
+    outcome.erection = erect(
+        patterns,
+        outcome.material,
+        job.material.thickness,
+        solver=options,
+        options=job.erection,
+        callback=callback,
+    )
+
+
+@dataclass
+class ErectionRun:
+    """What ``vares erect DIR`` did: the job it read, the erection and the files written."""
+
+    job: Job
+    result: ErectionResult
+    files: list[Path] = field(default_factory=list)
+
+
+def run_erection(
+    directory: str | Path,
+    options: ErectionOptions | None = None,
+    *,
+    force: bool = False,
+    report: bool = False,
+    callback: Callable[[IterationRecord], None] | None = None,
+) -> ErectionRun:
+    """Erect the patterns that a run wrote into ``directory`` (from its ``job.toml``, the panels'
+    ``surface.vtu``, ``pattern.vtu`` and ``summary.json``) and write ``directory/erect/`` (as one
+    set, added to the run's manifest).
+
+    ``options`` default to the job's ``[erection]`` table (or the defaults); the tolerance,
+    iteration limit and linear solver are the job's.
+    """
+    directory = Path(directory)
+    job_file = directory / JOB_FILE
+    if not job_file.is_file():
+        raise FileNotFoundError(
+            f"no {JOB_FILE} in {directory}: erect an output directory written by "
+            "'vares pattern', 'example', 'run' or 'panels'"
+        )
+    job = load_job(job_file).with_output(directory)
+    options = options or job.erection or ErectionOptions()
+    material = job.material.build(job.base)
+    patterns = saved_patterns(job)
+    target = directory / "erect"
+    folder = OutputFolder(
+        target,
+        erection_files(target, report),
+        force=force,
+        inputs=[],
+        manifest=False,
+        known=[p for p in listed(directory) if target.resolve() in p.resolve().parents],
+    )
+    folder.check()
+    result = erect(
+        patterns,
+        material,
+        job.material.thickness,
+        solver=job.solve,
+        options=options,
+        callback=callback,
+    )
+    units = job.input.units or "m"
+    root = folder.start()
+    try:
+        staged = write_erection(result, root, units)
+        if report:
+            from .erection_report import write_erection_report
+
+            staged.append(write_erection_report(result, root, units))
+        folder.commit()
+    finally:
+        folder.discard()
+    files = [directory / "erect" / Path(p).relative_to(root) for p in staged]
+    add_to_manifest(directory, files)
+    return ErectionRun(job, result, files)
 
 
 def _panel(

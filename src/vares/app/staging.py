@@ -22,9 +22,9 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from .._version import __version__
-from ..io.files import OutputExistsError
+from ..io.files import OutputExistsError, atomic_path
 
-__all__ = ["MANIFEST", "OutputFolder"]
+__all__ = ["MANIFEST", "OutputFolder", "add_to_manifest", "listed"]
 
 #: The file in an output folder that lists what the run wrote.
 MANIFEST = ".vares-run.json"
@@ -32,15 +32,25 @@ MANIFEST = ".vares-run.json"
 
 class OutputFolder:
     """The output folder ``directory`` of a run that will write ``planned`` (paths inside it)
-    and reads ``inputs``; see the module docs."""
+    and reads ``inputs``; see the module docs. A folder inside another run's (``erect/``) has
+    no manifest of its own (``manifest=False``): the files that run lists in it are ``known``."""
 
     def __init__(
-        self, directory: Path, planned: Iterable[Path], *, force: bool, inputs: Iterable[Path]
+        self,
+        directory: Path,
+        planned: Iterable[Path],
+        *,
+        force: bool,
+        inputs: Iterable[Path],
+        manifest: bool = True,
+        known: Iterable[Path] = (),
     ) -> None:
         self.directory = Path(directory).resolve()
         self.planned = [Path(p).resolve() for p in planned]
         self.force = force
         self.inputs = {Path(p).resolve() for p in inputs}
+        self.manifest = manifest
+        self.known = {Path(p).resolve() for p in known}
         self.staging: Path | None = None
 
     # ------------------------------------------------------------------ before the work
@@ -54,7 +64,9 @@ class OutputFolder:
         if self.directory.exists() and not self.directory.is_dir():
             raise OutputExistsError(f"the output folder {self.directory} is a file")
         existing = self._existing()
-        ours = self._previous() | {p.relative_to(self.directory) for p in self.planned}
+        ours = self._previous() | {
+            p.relative_to(self.directory) for p in [*self.planned, *self.known]
+        }
         foreign = sorted(str(p) for p in existing - ours)
         if foreign:
             shown = ", ".join(foreign[:4]) + (", …" if len(foreign) > 4 else "")
@@ -125,8 +137,9 @@ class OutputFolder:
             str(p.relative_to(self.staging)) for p in self.staging.rglob("*") if p.is_file()
         )
         manifest = {"vares_version": __version__, "files": files}
-        text = json.dumps(manifest, indent=2) + "\n"
-        (self.staging / MANIFEST).write_text(text, encoding="utf-8")
+        if self.manifest:
+            text = json.dumps(manifest, indent=2) + "\n"
+            (self.staging / MANIFEST).write_text(text, encoding="utf-8")
         os.chmod(self.staging, 0o777 & ~_umask())
         previous = None
         if self.directory.exists():
@@ -150,3 +163,28 @@ def _umask() -> int:
     current = os.umask(0)
     os.umask(current)
     return current
+
+
+def listed(directory: Path) -> list[Path]:
+    """The files a run's manifest lists (paths inside ``directory``)."""
+    try:
+        data = json.loads((Path(directory) / MANIFEST).read_text(encoding="utf-8"))
+        return [Path(directory) / p for p in data["files"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+
+
+def add_to_manifest(directory: Path, files: Iterable[Path]) -> None:
+    """Add files written into a run's folder afterwards (``vares erect``) to its manifest."""
+    directory = Path(directory).resolve()
+    path = directory / MANIFEST
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        data = {"vares_version": __version__, "files": []}
+    listed = set(data.get("files", []))
+    listed |= {str(Path(f).resolve().relative_to(directory)) for f in files}
+    data["files"] = sorted(listed)
+    text = json.dumps(data, indent=2) + "\n"
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8")

@@ -33,9 +33,11 @@ __all__ = [
     "CUT_EXAMPLES",
     "EXAMPLES",
     "EXAMPLE_PLANES",
+    "PANEL_NAMES",
     "STRUCTURE_EXAMPLES",
     "bumpy",
     "cap_over_square",
+    "catenoid_band",
     "catenoid_section",
     "cone_segment",
     "conic_tent",
@@ -434,6 +436,33 @@ def hypar_strips(
     return mesh, ids
 
 
+def catenoid_band(
+    panels: int = 12,
+    waist: float = 3.0,
+    height: float = 3.0,
+    n_along: int = 16,
+    n_around: int = 4,
+    cell_type: str = "triangle",
+) -> tuple[SurfaceMesh, np.ndarray]:
+    """A whole catenoid band (a minimal surface between two rings: waist radius ``waist``,
+    ``±height/2`` along z) cut along its meridians into ``panels`` gores of ``n_around`` cells
+    around each: the mesh and the panel id of every cell. Erected, the rings are the supports.
+    """
+    if panels < 2:
+        raise ValueError(f"a band needs at least two panels; got {panels}")
+    v = np.linspace(-height / 2, height / 2, n_along + 1)
+    count = panels * n_around
+    phi = np.linspace(0.0, 2 * np.pi, count + 1)[:-1]
+    r, p = np.meshgrid(waist * np.cosh(v / waist), phi, indexing="xy")
+    points = np.column_stack([(r * np.cos(p)).ravel(), (r * np.sin(p)).ravel(), np.tile(v, count)])
+    cells = grid_cells(len(v), count + 1, cell_type)
+    cells = {t: np.where(c >= len(points), c - len(points), c) for t, c in cells.items()}
+    mesh = SurfaceMesh(points, cells)
+    centroids = np.concatenate([mesh.points[c].mean(axis=1) for c in mesh.cells.values()])
+    angle = np.mod(np.arctan2(centroids[:, 1], centroids[:, 0]), 2 * np.pi)
+    return mesh, np.minimum((angle / (2 * np.pi / panels)).astype(int), panels - 1)
+
+
 def irregular_hypar_strips(
     strips: int = 10,
     size: float = 10.0,
@@ -559,6 +588,9 @@ CUT_EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {"saddle": saddle, "conic-
 #: Example structures by name: generators of a mesh and a panel id per cell (``vares panels``).
 STRUCTURE_EXAMPLES: dict[str, Callable[..., tuple[SurfaceMesh, np.ndarray]]] = {
     "hypar-strips": hypar_strips,
+    "catenoid-band": catenoid_band,
 }
+#: What the panels of each example structure are called (name-1, name-2, …).
+PANEL_NAMES = {"hypar-strips": "strip", "catenoid-band": "gore"}
 #: The initial-guess plane each example is meant to be patterned with.
 EXAMPLE_PLANES = {"cylinder160": "xy"}

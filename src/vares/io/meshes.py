@@ -248,17 +248,22 @@ def write_surface(
     mesh: SurfaceMesh,
     coordinates: np.ndarray | None = None,
     fields: dict[str, np.ndarray] | None = None,
+    point_data: dict[str, np.ndarray] | None = None,
 ) -> None:
-    """Write the mesh (or, with ``coordinates`` ``(n, 2)``, the flat pattern at z = 0).
+    """Write the mesh (or, with ``coordinates`` ``(n, 2)``, the flat pattern at z = 0; ``(n, 3)``,
+    the mesh moved there).
 
     The format follows the suffix (any format meshio writes: .obj, .vtu, .ply, .stl, …); nodes
     and cells are those of ``mesh``, in the same order. ``fields`` (per cell, global cell order)
-    are written as cell data where the format has it (VTU, VTK).
+    are written as cell data and ``point_data`` (per node) as point data where the format has
+    them (VTU, VTK).
     """
     import meshio
 
     points = mesh.points
-    if coordinates is not None:
+    if coordinates is not None and coordinates.shape[1] == 3:
+        points = np.asarray(coordinates, dtype=float)
+    elif coordinates is not None:
         points = np.column_stack([coordinates, np.zeros(len(coordinates))])
     blocks = list(mesh.cells.items())
     cell_data = {}
@@ -268,7 +273,8 @@ def write_surface(
             name: [np.asarray(values[a:b], dtype=float) for a, b in itertools.pairwise(bounds)]
             for name, values in fields.items()
         }
-    out = meshio.Mesh(points, blocks, cell_data=cell_data)
+    point_data = {k: np.asarray(v, dtype=float) for k, v in (point_data or {}).items()}
+    out = meshio.Mesh(points, blocks, cell_data=cell_data, point_data=point_data)
     # the temporary file keeps the suffix, from which meshio takes the format
     write_with(Path(path), lambda p: meshio.write(p, out))
 

@@ -50,6 +50,10 @@ FIELD_LABELS = {
     "pattern_area": "pattern area",
     "surface_area": "surface area",
     "warp_deviation": "warp deviation from the direction [°]",
+    "normal_deviation": "normal deviation from the design (length units)",
+    "state": "0 taut, 1 wrinkled, 2 slack",
+    "warp_stress_difference": "warp force − intended prestress [{stress}]",
+    "fill_stress_difference": "fill force − intended prestress [{stress}]",
 }
 #: Fields whose colour scale is centred on a neutral value (diverging colours).
 _CENTRED = {
@@ -66,6 +70,9 @@ _CENTRED = {
     "stress_max": 0.0,
     "stress_min": 0.0,
     "warp_deviation": 0.0,
+    "normal_deviation": 0.0,
+    "warp_stress_difference": 0.0,
+    "fill_stress_difference": 0.0,
 }
 
 

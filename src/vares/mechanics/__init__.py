@@ -1,18 +1,23 @@
 """The energy of erecting a pattern: prestress, element kernels, the problem, assembly, rigid
-modes, and the per-cell response (stresses, stretches) of any pattern."""
+modes, and the per-cell response (stresses, stretches) of any pattern; and the forward problem
+of the erection (the patterns fixed, the 3D positions unknown) with its tension-field energy."""
 
-from .assembly import Assembler
+from .assembly import Assembler, Connectivity
+from .erection import ErectionProblem
 from .fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
 from .kernels import BlockResult, block_energy, projected_hessian
 from .prestress import PrestressWarning, prestress_components, prestress_tensor
 from .problem import Evaluation, Problem
 from .rigid import rigid_modes
+from .wrinkling import relaxed_response
 
 __all__ = [
     "FIELD_DESCRIPTIONS",
     "KEY_FIELDS",
     "Assembler",
     "BlockResult",
+    "Connectivity",
+    "ErectionProblem",
     "Evaluation",
     "PrestressWarning",
     "Problem",
@@ -21,5 +26,6 @@ __all__ = [
     "prestress_components",
     "prestress_tensor",
     "projected_hessian",
+    "relaxed_response",
     "rigid_modes",
 ]

@@ -1,8 +1,9 @@
 """Global assembly with a sparsity pattern and scatter map built once per mesh.
 
-The unknowns are the pattern coordinates, two per node (dof ``2 a + i``). Some dofs are held
-fixed (rigid modes); the matrix is assembled directly over the free dofs. Building the map sorts
-all element-matrix entries once; every later assembly is a single weighted ``bincount``.
+The unknowns are ``d`` numbers per node (dof ``d a + i``): the pattern coordinates (``d = 2``) or
+the erected positions of the forward problem (``d = 3``). Some dofs are held fixed (rigid modes,
+supports); the matrix is assembled directly over the free dofs. The node pattern is built once
+(a sparse sum of the cells' node pairs); every later assembly is a single weighted ``bincount``.
 """
 
 from __future__ import annotations
@@ -13,7 +14,16 @@ from numba import njit
 
 from ..geometry.mesh import SurfaceMesh
 
-__all__ = ["Assembler"]
+__all__ = ["Assembler", "Connectivity"]
+
+
+class Connectivity:
+    """Node count and cell blocks (any element, also line elements): what an :class:`Assembler`
+    needs of a mesh. ``cells`` maps a block name to node indices ``(m, nen)``."""
+
+    def __init__(self, num_points: int, cells: dict[str, np.ndarray]) -> None:
+        self.num_points = int(num_points)
+        self.cells = {name: np.asarray(c, dtype=np.int64) for name, c in cells.items() if len(c)}
 
 
 class Assembler:
@@ -22,22 +32,28 @@ class Assembler:
     Parameters
     ----------
     mesh
-        The mesh whose cell blocks are assembled (in ``mesh.cells`` order).
+        The mesh (or :class:`Connectivity`) whose cell blocks are assembled, in ``mesh.cells``
+        order.
     free
-        Boolean mask ``(2 n,)`` of the dofs that are unknowns; the matrix is over these only.
+        Boolean mask ``(d n,)`` of the dofs that are unknowns; the matrix is over these only.
+    dofs_per_node
+        ``d``: 2 for a pattern, 3 for erected positions.
     """
 
-    def __init__(self, mesh: SurfaceMesh, free: np.ndarray) -> None:
+    def __init__(
+        self, mesh: SurfaceMesh | Connectivity, free: np.ndarray, dofs_per_node: int = 2
+    ) -> None:
         free = np.asarray(free, dtype=bool)
-        n = mesh.num_points
-        if free.shape != (2 * n,):
-            raise ValueError(f"free must have shape ({2 * n},); got {free.shape}")
+        n, d = mesh.num_points, int(dofs_per_node)
+        if free.shape != (d * n,):
+            raise ValueError(f"free must have shape ({d * n},); got {free.shape}")
         self.free = free
-        self.num_dofs = 2 * n
+        self.dofs_per_node = d
+        self.num_dofs = d * n
         self.num_free = int(free.sum())
 
-        # Node-level pattern first (a quarter of the entries), then each node pair (a, b)
-        # becomes the 2 × 2 dof block of rows 2a+i, columns 2b+j.
+        # Node-level pattern first (1/d² of the entries), then each node pair (a, b) becomes
+        # the d × d dof block of rows da+i, columns db+j.
         node_ptr, node_col = _node_pattern(mesh)
         degree = np.diff(node_ptr)
         node_row = np.repeat(np.arange(n), degree)
@@ -46,17 +62,17 @@ class Assembler:
             [_node_entries(cells, node_ptr, node_col) for cells in mesh.cells.values()]
         )
 
-        i = np.arange(2)[:, None]
-        j = np.arange(2)[None, :]
+        i = np.arange(d)[:, None]
+        j = np.arange(d)[None, :]
 
         def full_position(entry: np.ndarray) -> np.ndarray:
-            """Position in the full dof CSR of the 2 × 2 block (i, j) of node entries."""
+            """Position in the full dof CSR of the d × d block (i, j) of node entries."""
             a = node_row[entry][..., None, None]
-            return 4 * node_ptr[a] + i * 2 * degree[a] + 2 * within[entry][..., None, None] + j
+            return d * d * node_ptr[a] + i * d * degree[a] + d * within[entry][..., None, None] + j
 
         # full dof structure, then keep the free rows and columns
-        rows = (2 * node_row[:, None, None] + i + 0 * j).ravel()
-        cols = (2 * node_col[:, None, None] + j + 0 * i).ravel()
+        rows = (d * node_row[:, None, None] + i + 0 * j).ravel()
+        cols = (d * node_col[:, None, None] + j + 0 * i).ravel()
         order = full_position(np.arange(node_col.size)).ravel()
         full_rows = np.empty_like(rows)
         full_cols = np.empty_like(cols)
@@ -73,7 +89,7 @@ class Assembler:
 
         # entries in fixed rows or columns go to one extra slot that is dropped
         target = np.where(kept, np.cumsum(kept) - 1, self.nnz)
-        total = sum(c.shape[0] * (2 * c.shape[1]) ** 2 for c in mesh.cells.values())
+        total = sum(c.shape[0] * (d * c.shape[1]) ** 2 for c in mesh.cells.values())
         self._position = np.empty(total, dtype=np.int64)
         self._dofs = []
         entry_start = position_start = 0
@@ -84,24 +100,26 @@ class Assembler:
             _element_positions(
                 entries,
                 nen,
+                d,
                 node_row,
                 node_ptr,
                 degree,
                 within,
                 target,
-                self._position[position_start : position_start + m * 4 * nen * nen],
+                self._position[position_start : position_start + m * d * d * nen * nen],
             )
-            position_start += m * 4 * nen * nen
-            self._dofs.append((2 * cells[:, :, None] + np.arange(2)).reshape(m, -1))
+            position_start += m * d * d * nen * nen
+            self._dofs.append((d * cells[:, :, None] + np.arange(d)).reshape(m, -1))
         self._all_dofs = np.concatenate([d.ravel() for d in self._dofs])
 
     def vector(self, gradients: list[np.ndarray]) -> np.ndarray:
-        """Global gradient ``(n, 2)`` from per-cell gradients ``(m, nen, 2)`` of each block."""
+        """Global gradient ``(n, d)`` from per-cell gradients ``(m, nen, d)`` of each block."""
         values = np.concatenate([g.ravel() for g in gradients])
-        return np.bincount(self._all_dofs, weights=values, minlength=self.num_dofs).reshape(-1, 2)
+        d = self.dofs_per_node
+        return np.bincount(self._all_dofs, weights=values, minlength=self.num_dofs).reshape(-1, d)
 
     def matrix(self, hessians: list[np.ndarray]) -> sp.csr_matrix:
-        """Global Hessian over the free dofs (CSR) from per-cell ``(m, nen, 2, nen, 2)`` blocks."""
+        """Global Hessian over the free dofs (CSR) from per-cell ``(m, nen, d, nen, d)`` blocks."""
         values = np.concatenate([h.reshape(-1) for h in hessians])
         data = np.bincount(self._position, weights=values, minlength=self.nnz + 1)[:-1]
         return sp.csr_matrix(
@@ -109,7 +127,7 @@ class Assembler:
         )
 
 
-def _node_pattern(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
+def _node_pattern(mesh: SurfaceMesh | Connectivity) -> tuple[np.ndarray, np.ndarray]:
     """CSR pattern (row pointer, sorted column indices) of the node pairs that share a cell."""
     n = mesh.num_points
     rows = np.concatenate([np.repeat(c, c.shape[1], axis=1).ravel() for c in mesh.cells.values()])
@@ -143,21 +161,21 @@ def _node_entries(cells, node_ptr, node_col):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _element_positions(
-    entries, nen, node_row, node_ptr, degree, within, target, out
+    entries, nen, d, node_row, node_ptr, degree, within, target, out
 ):  # pragma: no cover
     """Matrix slot of every element Hessian entry, in the layout ``(m, a, i, b, j)``.
 
     ``entries`` holds the node-pattern entry of each node pair ``(m, a, b)``; the dof block of
-    node pair ``(a, b)`` starts in row ``2a + i`` at ``4 ptr[a] + 2 i deg[a] + 2 rank(b)``.
+    node pair ``(a, b)`` starts in row ``da + i`` at ``d² ptr[a] + d i deg[a] + d rank(b)``.
     """
     k = 0
     for e in range(entries.size // (nen * nen)):
         for a in range(nen):
-            for i in range(2):
+            for i in range(d):
                 for b in range(nen):
                     entry = entries[(e * nen + a) * nen + b]
                     row = node_row[entry]
-                    base = 4 * node_ptr[row] + 2 * i * degree[row] + 2 * within[entry]
-                    out[k] = target[base]
-                    out[k + 1] = target[base + 1]
-                    k += 2
+                    base = d * d * node_ptr[row] + d * i * degree[row] + d * within[entry]
+                    for j in range(d):
+                        out[k + j] = target[base + j]
+                    k += d

@@ -28,7 +28,14 @@ from numba import njit
 from ..geometry.elements import ReferenceElement, determinant, inverse
 from ..materials import Fibres, Hyperelastic
 
-__all__ = ["BlockResult", "block_energy", "determinant", "inverse", "projected_hessian"]
+__all__ = [
+    "BlockResult",
+    "block_energy",
+    "determinant",
+    "inverse",
+    "project_psd",
+    "projected_hessian",
+]
 
 _EYE = np.eye(2)
 
@@ -118,7 +125,7 @@ def projected_hessian(
     point's ``∂²W/∂J²`` set to zero: positive semi-definite, for Newton steps far from the
     solution (real arithmetic only)."""
     projected = jacobian_hessian.copy()
-    _project_psd(projected)
+    project_psd(projected)
     scale = thickness * element.quadrature_weights
     return _nodal_hessian(projected, np.ascontiguousarray(element.shape_gradients), scale)
 
@@ -276,21 +283,23 @@ def _nodal_hessian(jacobian_hessian, shape_gradients, scale):  # pragma: no cove
 
 
 @njit(cache=True)
-def _project_psd(jacobian_hessian):  # pragma: no cover
-    """Set the negative eigenvalues of every 4 × 4 block to zero, in place (cyclic Jacobi).
+def project_psd(jacobian_hessian):  # pragma: no cover
+    """Set the negative eigenvalues of every n × n block ``(m, q, n, n)`` to zero, in place
+    (cyclic Jacobi).
 
     Blocks with a positive, diagonally dominant diagonal are positive semi-definite already and
     are left alone.
     """
-    a = np.empty((4, 4))
-    v = np.empty((4, 4))
+    n = jacobian_hessian.shape[2]
+    a = np.empty((n, n))
+    v = np.empty((n, n))
     for e in range(jacobian_hessian.shape[0]):
         for q in range(jacobian_hessian.shape[1]):
             h = jacobian_hessian[e, q]
             dominant = True
-            for r in range(4):
+            for r in range(n):
                 off = 0.0
-                for c in range(4):
+                for c in range(n):
                     if c != r:
                         off += abs(0.5 * (h[r, c] + h[c, r]))
                 if h[r, r] < off:
@@ -298,20 +307,20 @@ def _project_psd(jacobian_hessian):  # pragma: no cover
             if dominant:
                 continue
             scale = 0.0
-            for r in range(4):
-                for c in range(4):
+            for r in range(n):
+                for c in range(n):
                     a[r, c] = 0.5 * (h[r, c] + h[c, r])
                     v[r, c] = 1.0 if r == c else 0.0
                     scale += a[r, c] * a[r, c]
             for _sweep in range(30):
                 off = 0.0
-                for r in range(3):
-                    for c in range(r + 1, 4):
+                for r in range(n - 1):
+                    for c in range(r + 1, n):
                         off += a[r, c] * a[r, c]
                 if off <= 1e-30 * scale:
                     break
-                for p in range(3):
-                    for r in range(p + 1, 4):
+                for p in range(n - 1):
+                    for r in range(p + 1, n):
                         if a[p, r] == 0.0:
                             continue
                         theta = (a[r, r] - a[p, p]) / (2.0 * a[p, r])
@@ -320,22 +329,22 @@ def _project_psd(jacobian_hessian):  # pragma: no cover
                         )
                         cos = 1.0 / np.sqrt(t * t + 1.0)
                         sin = t * cos
-                        for k in range(4):  # A ← A G (columns p, r)
+                        for k in range(n):  # A ← A G (columns p, r)
                             akp, akr = a[k, p], a[k, r]
                             a[k, p] = cos * akp - sin * akr
                             a[k, r] = sin * akp + cos * akr
-                        for k in range(4):  # A ← Gᵀ A (rows p, r)
+                        for k in range(n):  # A ← Gᵀ A (rows p, r)
                             apk, ark = a[p, k], a[r, k]
                             a[p, k] = cos * apk - sin * ark
                             a[r, k] = sin * apk + cos * ark
-                        for k in range(4):
+                        for k in range(n):
                             vkp, vkr = v[k, p], v[k, r]
                             v[k, p] = cos * vkp - sin * vkr
                             v[k, r] = sin * vkp + cos * vkr
-            for r in range(4):
-                for c in range(4):
+            for r in range(n):
+                for c in range(n):
                     value = 0.0
-                    for k in range(4):
+                    for k in range(n):
                         if a[k, k] > 0.0:
                             value += v[r, k] * a[k, k] * v[c, k]
                     h[r, c] = value

@@ -19,7 +19,7 @@ from ..materials import Fibres, Hyperelastic, MaterialError
 from .kernels import block_energy, determinant, projected_hessian
 from .prestress import prestress_components, prestress_tensor
 
-__all__ = ["Evaluation", "Problem"]
+__all__ = ["Evaluation", "Problem", "first_positive_root"]
 
 
 @dataclass(frozen=True)
@@ -191,7 +191,7 @@ class Problem:
             element = ELEMENTS[cell_type]
             J = element.jacobians(coordinates, cells, at="check")
             D = element.jacobians(delta, cells, at="check")
-            bound = min(bound, _first_root(J, D))
+            bound = min(bound, first_positive_root(J, D))
         return bound
 
     @property
@@ -200,7 +200,7 @@ class Problem:
         return self.material.stiffness_scale * self.thickness * np.sqrt(self.mesh.area)
 
 
-def _first_root(J: np.ndarray, D: np.ndarray) -> float:
+def first_positive_root(J: np.ndarray, D: np.ndarray) -> float:
     """Smallest positive root of ``det(J + α D)`` over all points (``inf`` if none)."""
     a = determinant(D)
     b = J[..., 0, 0] * D[..., 1, 1] + D[..., 0, 0] * J[..., 1, 1]

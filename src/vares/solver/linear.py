@@ -57,31 +57,57 @@ def _finite(x: np.ndarray) -> np.ndarray:
 
 class SuperLUSolver:
     """SciPy's SuperLU told that the matrix is symmetric: a symmetric fill-reducing ordering
-    (minimum degree on AᵀA + A), the diagonal preferred as pivot (threshold 0.01, so a zero
-    diagonal of a bordered system still pivots off it). Told nothing, SuperLU pivots for a
-    general matrix and can fill in catastrophically on irregular meshes (minutes instead of
-    seconds on a 50k-triangle scan: docs/benchmarks.md)."""
+    (minimum degree on AᵀA + A) and pivots on the diagonal, which keep the fill of a symmetric
+    factorisation (for a positive definite matrix as stable as Cholesky). Told nothing, SuperLU
+    pivots for a general matrix and can fill in catastrophically: minutes instead of seconds on
+    a 50k-triangle scan, and a near-complete fill of the erection's tangent, whose out-of-plane
+    diagonal is far smaller than its in-plane couplings (docs/benchmarks.md). A factorisation
+    that meets a zero pivot, or a solve whose residual exceeds
+    :data:`DIAGONAL_PIVOTING_RESIDUAL` of the right-hand side (an indefinite matrix with small
+    pivots, a bordered system), is redone with partial pivoting.
+    """
 
     name = "scipy-superlu"
 
     def __init__(self) -> None:
         self._lu = None
+        self._matrix = None
+        self._pivoted_on_diagonal = False
 
     def factorize(self, matrix: sp.csr_matrix) -> None:
+        self._matrix = matrix
         try:
             self._lu = spla.splu(
                 matrix.tocsc(),
                 permc_spec="MMD_AT_PLUS_A",
-                diag_pivot_thresh=0.01,
+                diag_pivot_thresh=0.0,
                 options={"SymmetricMode": True},
             )
+            self._pivoted_on_diagonal = True
+        except RuntimeError:  # a zero pivot on the diagonal: pivot by rows instead
+            self._partial_pivoting()
+
+    def _partial_pivoting(self) -> None:
+        try:
+            self._lu = spla.splu(self._matrix.tocsc(), permc_spec="MMD_AT_PLUS_A")
         except RuntimeError as exc:  # SuperLU reports exact singularity this way
             raise SingularMatrixError(str(exc)) from exc
+        self._pivoted_on_diagonal = False
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         if self._lu is None:
             raise RuntimeError("factorize() must be called before solve()")
-        return _finite(self._lu.solve(rhs))
+        x = self._lu.solve(rhs)
+        if self._pivoted_on_diagonal:
+            residual = np.linalg.norm(self._matrix @ x - rhs)
+            if not residual <= DIAGONAL_PIVOTING_RESIDUAL * np.linalg.norm(rhs):
+                self._partial_pivoting()
+                x = self._lu.solve(rhs)
+        return _finite(x)
+
+
+#: Relative residual above which a solve with diagonal pivots is redone with partial pivoting.
+DIAGONAL_PIVOTING_RESIDUAL = 1e-9
 
 
 _PARDISO = None

@@ -62,13 +62,16 @@ def describe_cells(ids: np.ndarray, limit: int = 5) -> str:
     return f"{ids.size} cell(s) ({shown}{', …' if ids.size > limit else ''})"
 
 
-def at_round_off(residuals: list[float], step_lengths: list[float]) -> bool:
-    """True when the last two full Newton steps (step length 1) each failed to halve the
-    relative residual, below :data:`ROUND_OFF_REGIME`: near the solution Newton's method
+def at_round_off(
+    residuals: list[float], step_lengths: list[float], regime: float = ROUND_OFF_REGIME
+) -> bool:
+    """True when the last two full Newton steps (step length 1) both left the relative residual
+    above half the least one before them, below ``regime``: near the solution Newton's method
     converges quadratically, so such a stall is the floor that round-off sets, not slowness."""
-    if len(residuals) < 3 or residuals[-1] > ROUND_OFF_REGIME:
+    if len(residuals) < 3 or residuals[-1] > regime:
         return False
-    stalled = all(residuals[k] > 0.5 * residuals[k - 1] for k in (-1, -2))
+    best = min(residuals[:-2])
+    stalled = residuals[-1] > 0.5 * best and residuals[-2] > 0.5 * best
     return stalled and step_lengths[-1] == 1.0 and step_lengths[-2] == 1.0
 
 
@@ -87,6 +90,10 @@ class NewtonContext:
     steps: list[StepRecord]
     callback: Callable[[IterationRecord], None] | None
     constraint: np.ndarray | None = None
+    #: Below this relative residual a stall counts as the round-off floor (:func:`at_round_off`);
+    #: an objective whose energy has kinks (the erection's tension field) stalls above its
+    #: round-off floor where states switch, and sets it lower.
+    round_off_regime: float = ROUND_OFF_REGIME
 
     def residual(self, gradient: np.ndarray) -> np.ndarray:
         """The residual over the free dofs, less its component along the linear constraint."""
@@ -186,7 +193,9 @@ def newton(
         initial_residual = residual if initial_residual is None else initial_residual
         residuals.append(residual / ctx.force_scale)
         step_lengths.append(step_length)
-        converged = residual <= ctx.residual_tolerance or at_round_off(residuals, step_lengths)
+        converged = residual <= ctx.residual_tolerance or at_round_off(
+            residuals, step_lengths, ctx.round_off_regime
+        )
         # far from the solution (by the residual) the projected tangent, near it the exact one
         projected = (
             method == "line-search"

@@ -11,6 +11,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from ...analysis.erection import ErectionResult
 from ...analysis.statistics import field_statistics
 from ...geometry.mesh import MeshError
 from ...io.files import OutputExistsError
@@ -23,7 +24,7 @@ from ..outcome import JobOutcome, PanelOutcome
 from ..runner import run_job
 from .flags import InputError
 
-__all__ = ["console", "execute", "fail", "field_table", "guarded"]
+__all__ = ["console", "execute", "fail", "field_table", "guarded", "show_erection"]
 
 console = Console(stderr=True, highlight=False, soft_wrap=True)
 
@@ -171,6 +172,49 @@ def _show_cut(outcome: JobOutcome) -> None:
         )
 
 
+def show_erection(result: ErectionResult, units: str) -> None:
+    """Print what an erection did: status, and design shape against erected."""
+    status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
+    console.print(
+        f"erection of {len(result.panels)} panel(s), {result.mesh.num_points} nodes "
+        f"({int(result.held.sum())} held): {status} in {result.iterations} iterations, "
+        f"{result.elapsed:.2f} s"
+    )
+    if not result.converged:
+        return
+    table = Table(
+        "",
+        "on the design shape",
+        "after erection",
+        title="membrane forces (force/length; means and RMS weighted by the design area)",
+    )
+    design, after = result.statistics(design=True), result.statistics()
+    for yarn in ("warp", "fill"):
+        d, a = design["stress"][yarn], after["stress"][yarn]
+        table.add_row(f"{yarn} intended", f"{d['intended']:.4g}", f"{a['intended']:.4g}")
+        table.add_row(f"{yarn} mean", f"{d['mean']:.4g}", f"{a['mean']:.4g}")
+        table.add_row(
+            f"{yarn} min … max",
+            f"{d['min']:.4g} … {d['max']:.4g}",
+            f"{a['min']:.4g} … {a['max']:.4g}",
+        )
+        table.add_row(
+            f"{yarn} RMS from intended", f"{d['rms_deviation']:.3g}", f"{a['rms_deviation']:.3g}"
+        )
+    for key in ("wrinkled", "slack"):
+        table.add_row(
+            f"{key} area",
+            f"{100 * design[f'{key}_area_fraction']:.1f} %",
+            f"{100 * after[f'{key}_area_fraction']:.1f} %",
+        )
+    console.print(table)
+    deviation = result.deviation()
+    console.print(
+        f"normal deviation from the design: max {deviation['max']:.3g} {units}, "
+        f"RMS {deviation['rms']:.3g} {units}"
+    )
+
+
 def show(outcome: JobOutcome) -> None:
     """Print what a job did: per pattern its status (and figures), the structure's seams, the
     warnings and the files."""
@@ -186,6 +230,8 @@ def show(outcome: JobOutcome) -> None:
         warnings = warnings + [
             f"{p.name}: {w}" for p in outcome.panels for w in p.warnings if w not in warnings
         ]
+    if outcome.erection is not None:
+        show_erection(outcome.erection, outcome.units)
     for warning in warnings:
         console.print(f"[yellow]warning:[/] {warning}")
     for path in outcome.files:
@@ -206,6 +252,8 @@ def execute(job: Job, *, force: bool, quiet: bool, save_job: Path | None = None)
     )
     if not quiet:
         show(outcome)
-    if not outcome.converged:
+    if not outcome.patterned:
         what = "solve" if outcome.structure is None else "structure"
         raise typer.Exit(fail(f"the {what} did not converge: {outcome.reason}", 1))
+    if not outcome.converged:
+        raise typer.Exit(fail(f"the erection did not converge: {outcome.erection.reason}", 1))

@@ -16,6 +16,7 @@ from typing import Annotated, Any
 
 import typer
 
+from ...analysis.options import ErectionOptions
 from ...options import Options, OptionsError, Spec
 from ...solver.options import SolveOptions
 from ...structures.options import CutOptions, StructureOptions
@@ -23,8 +24,11 @@ from ..job import Job
 from ..sections import InputOptions, MaterialOptions, OutputOptions, PrestressOptions
 
 __all__ = [
+    "ERECTION_FLAGS",
+    "ERECT_FLAG",
     "InputError",
     "build",
+    "erection_from_flags",
     "flag_name",
     "flags",
     "job_from_flags",
@@ -42,6 +46,7 @@ PANELS = {
     "solver": "Solver",
     "output": "Output",
     "structure": "Structure",
+    "erection": "Erection",
     "cut": "Cutting and nesting",
 }
 #: Kinds given on the command line as one comma-separated string.
@@ -198,6 +203,35 @@ PRESTRESS_FLAGS = [
 ]
 
 
+#: ``--erect``: erect the structure from its patterns right after patterning.
+ERECT_FLAG = [
+    option_parameter(
+        "erect",
+        False,
+        bool,
+        "--erect",
+        help="Erect the structure from its patterns afterwards (files in OUTPUT/erect/; see "
+        "'vares erect').",
+        panel=PANELS["erection"],
+    )
+]
+#: The erection options' flags.
+ERECTION_FLAGS = flags(ErectionOptions)
+
+
+def erection_from_flags(values: dict[str, Any], *, erect: bool) -> ErectionOptions | None:
+    """The erection options the flags describe, or None without ``erect``; an erection flag
+    given without it is an error."""
+    options = build(ErectionOptions, values)
+    if erect:
+        return options
+    changed = [n for n, d in ErectionOptions.defaults().items() if getattr(options, n) != d]
+    if changed:
+        flag = flag_name(changed[0], ErectionOptions.specs()[changed[0]])
+        raise InputError(f"{flag} is an erection option: add --erect")
+    return None
+
+
 def _prestress(values: dict[str, Any]) -> dict[str, Any]:
     given, field = values.get("prestress"), values.get("prestress_field")
     if given is not None and field is not None:
@@ -220,6 +254,8 @@ JOB_FLAGS = (
     + PRESTRESS_FLAGS
     + flags(PrestressOptions)
     + flags(OutputOptions)
+    + ERECT_FLAG
+    + ERECTION_FLAGS
 )
 
 
@@ -267,5 +303,6 @@ def job_from_flags(
         prestress=build(PrestressOptions, values, **_prestress(values)),
         output=build(OutputOptions, values),
         structure=build(StructureOptions, values) if structure else None,
+        erection=erection_from_flags(values, erect=values.get("erect", False)),
         base=Path.cwd(),
     )

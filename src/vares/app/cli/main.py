@@ -6,6 +6,7 @@ import typer
 
 from .batch import batch
 from .cut import cut
+from .erect import erect
 from .evaluate import evaluate
 from .fabrics import fabrics
 from .panels import panels
@@ -20,7 +21,7 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-for command in (pattern, example, run, evaluate, fabrics, panels, cut, batch):
+for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch):
     app.command()(command)
 
 

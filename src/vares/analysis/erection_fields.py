@@ -1,0 +1,145 @@
+"""Results of an erection: per cell the membrane forces and the wrinkling state, per node the
+displacement from the design and its normal component, and their statistics.
+
+Membrane forces are force per length: thickness × the Cauchy stress of the relaxed (or plain)
+law, without the regularising tension. A cell is **taut** when both principal forces are
+positive, **wrinkled** when one is ≤ 0 < the other (uniaxial tension), **slack** when neither is
+positive (round-off of a stress-free state counts as zero). Means, RMS values and area fractions
+are weighted by the cells' areas on the design surface.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry.elements import ELEMENTS, determinant
+from ..geometry.mesh import SurfaceMesh
+from ..mechanics.erection import ErectionProblem
+from ..mechanics.fields import COMPRESSION_TOLERANCE
+from ..mechanics.forward import forward_block
+
+__all__ = [
+    "CELL_FIELDS",
+    "STATE_NAMES",
+    "erection_statistics",
+    "membrane_forces",
+    "node_normals",
+    "stress_statistics",
+]
+
+#: Per-cell results of an erection: name → (description, unit kind).
+CELL_FIELDS: dict[str, tuple[str, str]] = {
+    "warp_stress": ("membrane force along the erected warp", "force/length"),
+    "fill_stress": ("membrane force along the erected fill", "force/length"),
+    "stress_max": ("larger principal membrane force", "force/length"),
+    "stress_min": ("smaller principal membrane force", "force/length"),
+    "warp_stress_difference": ("warp force minus the intended prestress", "force/length"),
+    "fill_stress_difference": ("fill force minus the intended prestress", "force/length"),
+    "state": ("0 taut, 1 wrinkled (uniaxial tension), 2 slack", "1"),
+    "det_F": ("area ratio erected/pattern", "1"),
+    "surface_area": ("area of the cell on the design surface", "area"),
+}
+STATE_NAMES = ("taut", "wrinkled", "slack")
+
+
+def membrane_forces(
+    problem: ErectionProblem,
+    x: np.ndarray,
+    cell_ids: list[np.ndarray],
+    num_cells: int,
+    *,
+    relaxed: bool,
+) -> dict[str, np.ndarray]:
+    """Per-cell membrane forces and state at the positions ``x`` ``(n, 3)`` (welded cell order;
+    ``cell_ids`` holds the welded ids of every membrane block's cells)."""
+    names = ("warp_stress", "fill_stress", "stress_max", "stress_min", "det_F")
+    out = {name: np.zeros(num_cells) for name in names}
+    t = problem.thickness
+    for block, ids in zip(problem.blocks, cell_ids, strict=True):
+        weights = block.reference.weights
+        captured = {}
+
+        def respond(C, tangent, fibres=block.fibres, captured=captured):
+            # the law's stresses, without the regularising tension
+            psi, S, cc = problem.response(fibres, relaxed)(C, tangent)
+            captured["C"], captured["S"] = C, S - problem.tension * np.eye(2)
+            return psi, S, cc
+
+        forward_block(block.reference, x[block.cells], respond, order=0)
+        C, S = captured["C"], captured["S"]
+        det_f = np.sqrt(np.maximum(determinant(C), 1e-300))
+        fibres = block.fibres
+        warp = (1.0, 0.0) if fibres is None else fibres.warp
+        fill = (0.0, 1.0) if fibres is None else fibres.fill
+        CSC = C @ S @ C
+        values = {
+            "warp_stress": _along(CSC, C, warp) / det_f,
+            "fill_stress": _along(CSC, C, fill) / det_f,
+            "det_F": det_f,
+        }
+        SC = S @ C  # its eigenvalues are real: it is similar to the symmetric C½ S C½
+        half = 0.5 * (SC[..., 0, 0] + SC[..., 1, 1])
+        difference = 0.5 * (SC[..., 0, 0] - SC[..., 1, 1])
+        # (not √(half² − det): that loses half the digits where the eigenvalues are close)
+        root = np.sqrt(np.maximum(difference**2 + SC[..., 0, 1] * SC[..., 1, 0], 0.0))
+        values["stress_max"], values["stress_min"] = (half + root) / det_f, (half - root) / det_f
+        for name, value in values.items():
+            scale = 1.0 if name == "det_F" else t
+            out[name][ids] = scale * np.sum(weights * value, axis=1) / weights.sum(axis=1)
+    tolerance = COMPRESSION_TOLERANCE * problem.material.stiffness_scale * t
+    out["state"] = np.where(
+        out["stress_min"] > tolerance, 0.0, np.where(out["stress_max"] > tolerance, 1.0, 2.0)
+    )
+    return out
+
+
+def _along(CSC: np.ndarray, C: np.ndarray, phi) -> np.ndarray:
+    """``Φ·CSCΦ / Φ·CΦ``: the Cauchy stress along the erected ``FΦ``, times ``det F``."""
+    phi = np.asarray(phi, dtype=float)
+    return np.einsum("a,...ab,b->...", phi, CSC, phi) / np.einsum("a,...ab,b->...", phi, C, phi)
+
+
+def node_normals(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normals ``(n, 3)`` of the surface at its nodes (cell area vectors summed) and the
+    nodes' lumped areas ``(n,)`` (each cell's area shared equally by its nodes)."""
+    normals = np.zeros((mesh.num_points, 3))
+    lumped = np.zeros(mesh.num_points)
+    for cell_type, cells in mesh.cells.items():
+        element = ELEMENTS[cell_type]
+        j = element.jacobians(mesh.points, cells)
+        vector = np.einsum("mqi,q->mi", np.cross(j[..., 0], j[..., 1]), element.quadrature_weights)
+        area = np.linalg.norm(vector, axis=1)
+        for a in range(cells.shape[1]):
+            np.add.at(normals, cells[:, a], vector)
+            np.add.at(lumped, cells[:, a], area / cells.shape[1])
+    return normals / np.linalg.norm(normals, axis=1, keepdims=True), lumped
+
+
+def stress_statistics(
+    values: np.ndarray, intended: np.ndarray, area: np.ndarray
+) -> dict[str, float]:
+    """``mean``, ``min``, ``max``, ``intended`` (mean) and ``rms_deviation`` of one yarn's forces,
+    weighted by ``area``."""
+    total = area.sum()
+    return {
+        "mean": float(values @ area / total),
+        "min": float(values.min()),
+        "max": float(values.max()),
+        "intended": float(intended @ area / total),
+        "rms_deviation": float(np.sqrt((values - intended) ** 2 @ area / total)),
+    }
+
+
+def erection_statistics(
+    fields: dict[str, np.ndarray], intended: np.ndarray, area: np.ndarray
+) -> dict[str, object]:
+    """Stress statistics per yarn and the wrinkled and slack area fractions."""
+    total = area.sum()
+    return {
+        "stress": {
+            yarn: stress_statistics(fields[f"{yarn}_stress"], intended[:, k], area)
+            for k, yarn in enumerate(("warp", "fill"))
+        },
+        "wrinkled_area_fraction": float(area[fields["state"] == 1].sum() / total),
+        "slack_area_fraction": float(area[fields["state"] == 2].sum() / total),
+    }

@@ -1,0 +1,76 @@
+"""The options of an erection analysis, declared once (see :mod:`vares.options`): the
+``[erection]`` table of a job, the keywords of :func:`vares.erect` and the flags of
+``vares erect`` (and of ``--erect`` on the patterning commands)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..options import Options, OptionsError, option
+
+__all__ = ["ErectionOptions"]
+
+
+@dataclass(frozen=True)
+class ErectionOptions(Options):
+    """How the structure is built from its patterns (see :func:`vares.erect`)."""
+
+    title = "erection option"
+
+    wrinkling: bool = option(
+        True,
+        "bool",
+        "Tension-field energy: the membrane carries no compression (it wrinkles or goes slack).",
+        section="erection",
+        flags=("--wrinkling/--no-wrinkling",),
+    )
+    pressure: float = option(
+        0.0,
+        "float",
+        "Uniform pressure along the surface normal (force/area), following the surface; needs "
+        "every boundary node held (no edge cables).",
+        section="erection",
+    )
+    cable_stiffness: float | None = option(
+        None,
+        "float",
+        "Axial stiffness EA (force) of edge cables: given, every boundary stretch between two "
+        "corners is a tension-only cable and only the corners are held.",
+        section="erection",
+        positive=True,
+    )
+    cable_force: float = option(
+        0.0,
+        "float",
+        "Design force of the edge cables: each is cut to its design length / (1 + force/EA).",
+        section="erection",
+        minimum=0,
+    )
+    corner_angle: float = option(
+        30.0,
+        "float",
+        "Boundary nodes where the boundary turns by more than this (degrees) are corners, held "
+        "by the supports when there are edge cables.",
+        section="erection",
+        positive=True,
+    )
+    regularisation: float = option(
+        1e-6,
+        "float",
+        "Fictitious isotropic tension in every cell, relative to the material's stiffness: slack "
+        "regions hang taut at it instead of having no determinate shape, and Newton's method "
+        "converges through wrinkling; not part of the reported forces (0 for a structure "
+        "without prestress).",
+        section="erection",
+        minimum=0,
+    )
+
+    def check(self) -> None:
+        if self.pressure and self.cable_stiffness is not None:
+            raise OptionsError(
+                None,
+                "pressure with edge cables is not available: the pressure on a membrane whose "
+                "boundary moves is not conservative (hold the boundary, or leave out the pressure)",
+            )
+        if self.corner_angle >= 180.0:
+            raise OptionsError("corner_angle", f"must be < 180; got {self.corner_angle!r}")

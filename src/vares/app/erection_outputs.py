@@ -1,0 +1,88 @@
+"""The files of an erection, in the output directory's ``erect/``:
+
+``erect.json``                  the key figures (converged, deviation, stresses against the
+                                intended prestress, wrinkled and slack area) and the history
+``erected.vtu``                 the erected surface with the displacement and normal deviation
+                                per node, the membrane forces and states (and those on the design
+                                shape, ``design_*``) per cell
+``erected.obj``                 the erected surface
+``deviation.png``, ``warp_stress.png``, ``fill_stress.png``, ``state.png``  drawn on it
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.erection import ErectionResult
+from ..io.files import atomic_path, write_json
+from ..io.meshes import write_surface
+
+__all__ = ["ERECTION_FILES", "erection_files", "write_erection"]
+
+#: The files of an erection, in the output directory's ``erect/``.
+ERECTION_FILES = (
+    "erect.json",
+    "erected.vtu",
+    "erected.obj",
+    "deviation.png",
+    "warp_stress.png",
+    "fill_stress.png",
+    "state.png",
+)
+
+
+def erection_files(directory: Path, report: bool = False) -> list[Path]:
+    """The files an erection writes into ``directory``."""
+    return [directory / n for n in ERECTION_FILES + (("report.html",) if report else ())]
+
+
+def write_erection(result: ErectionResult, directory: Path, units: str) -> list[Path]:
+    """The files of an erection (:data:`ERECTION_FILES`) in ``directory``; returns their paths."""
+    import matplotlib.pyplot as plt
+
+    from ..io.plot import plot_surface
+
+    files = []
+    fields = dict(result.fields) | {f"design_{k}": v for k, v in result.design_fields.items()}
+    points = {
+        "displacement": result.displacement,
+        "normal_deviation": result.normal_deviation,
+        "held": result.held.astype(float),
+    }
+    writers = {
+        "erect.json": lambda p: write_json(p, result.to_dict(units=units)),
+        "erected.vtu": lambda p: write_surface(
+            p, result.mesh, result.erected_points, fields, points
+        ),
+        "erected.obj": lambda p: write_surface(p, result.mesh, result.erected_points),
+    }
+    for name, writer in writers.items():
+        writer(directory / name)
+        files.append(directory / name)
+    erected = result.erected_mesh
+    per_cell = np.concatenate(
+        [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
+    )
+    scale = result.material.stiffness_scale * result.thickness
+    drawings = {
+        "deviation.png": (per_cell, "normal_deviation", f"normal deviation ({units})"),
+        "warp_stress.png": (result.fields["warp_stress"], "warp_stress", "warp force, erected"),
+        "fill_stress.png": (result.fields["fill_stress"], "fill_stress", "fill force, erected"),
+        "state.png": (result.fields["state"], "state", "taut / wrinkled / slack, erected"),
+    }
+    for name, (values, field, title) in drawings.items():
+        fig = plot_surface(
+            erected,
+            values,
+            field=field,
+            title=title,
+            stress_unit="force/length",
+            stress_scale=scale,
+        )
+        with atomic_path(directory / name) as temporary:
+            fig.savefig(temporary, dpi=150)
+        plt.close(fig)
+        files.append(directory / name)
+    return files

@@ -1,0 +1,158 @@
+"""The erection section of the HTML reports: the stresses on the design shape (what the
+patterning reports: the patterns forced onto the surface) against those after erection (what the
+structure really carries), the deviation from the design and where the membrane wrinkles.
+
+It goes into a job's ``report.html`` (the pattern's, or the structure's) when the job erects, and
+``vares erect DIR --report`` writes it on its own as ``DIR/erect/report.html``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.erection import ErectionResult
+from ..io.files import atomic_path
+from .html_parts import figure, number, page, status_text, table
+
+__all__ = ["erection_section", "write_erection_report"]
+
+
+def _comparison_rows(result: ErectionResult, units: str) -> list[tuple[str, str, str]]:
+    design, after = result.statistics(design=True), result.statistics()
+    rows = []
+    for yarn in ("warp", "fill"):
+        d, a = design["stress"][yarn], after["stress"][yarn]
+        rows += [
+            (f"{yarn}: intended prestress", number(d["intended"]), number(a["intended"])),
+            (f"{yarn}: mean", number(d["mean"]), number(a["mean"])),
+            (
+                f"{yarn}: min … max",
+                f"{number(d['min'])} … {number(d['max'])}",
+                f"{number(a['min'])} … {number(a['max'])}",
+            ),
+            (
+                f"{yarn}: RMS deviation from intended",
+                number(d["rms_deviation"], 3),
+                number(a["rms_deviation"], 3),
+            ),
+        ]
+    for key, label in (("wrinkled", "wrinkled area (uniaxial tension)"), ("slack", "slack area")):
+        rows.append(
+            (
+                label,
+                f"{100 * design[f'{key}_area_fraction']:.1f} %",
+                f"{100 * after[f'{key}_area_fraction']:.1f} %",
+            )
+        )
+    deviation = result.deviation()
+    rows += [
+        (
+            "normal deviation, max / RMS",
+            "0 / 0",
+            f"{number(deviation['max'], 3)} / {number(deviation['rms'], 3)} {units}",
+        ),
+        (
+            "area",
+            f"{number(result.surface_area)} {units}²",
+            f"{number(result.erected_area)} {units}²",
+        ),
+    ]
+    return rows
+
+
+def _figures(result: ErectionResult, units: str) -> list[str]:
+    from ..io.plot import plot_surface
+
+    erected = result.erected_mesh
+    scale = result.material.stiffness_scale * result.thickness
+    per_cell = np.concatenate(
+        [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
+    )
+    drawings = [
+        (erected, per_cell, "normal_deviation", f"normal deviation from the design ({units})"),
+        (
+            result.mesh,
+            result.design_fields["warp_stress"],
+            "warp_stress",
+            "warp force on the design shape",
+        ),
+        (erected, result.fields["warp_stress"], "warp_stress", "warp force after erection"),
+        (
+            result.mesh,
+            result.design_fields["fill_stress"],
+            "fill_stress",
+            "fill force on the design shape",
+        ),
+        (erected, result.fields["fill_stress"], "fill_stress", "fill force after erection"),
+        (erected, result.fields["state"], "state", "taut (0) / wrinkled (1) / slack (2)"),
+    ]
+    out = []
+    for k, (mesh, values, field, caption) in enumerate(drawings):
+        drawing = plot_surface(
+            mesh,
+            values,
+            field=field,
+            title=caption,
+            stress_unit="force/length",
+            stress_scale=scale,
+        )
+        out.append(figure(drawing, caption, f"figure-erection-{k}"))
+    return out
+
+
+def erection_section(result: ErectionResult, units: str) -> list[str]:
+    """The section: status, comparison table (force per length), figures."""
+    key = [
+        ("status", "converged" if result.converged else f"not converged: {result.reason}"),
+        ("panels welded", len(result.panels)),
+        ("nodes / cells", f"{result.mesh.num_points} / {result.mesh.num_cells}"),
+        ("supports", f"{int(result.held.sum())} nodes held"),
+        ("wrinkling", "tension field (no compression)" if result.options.wrinkling else "off"),
+        ("pressure", number(result.options.pressure)),
+        ("Newton iterations", result.iterations),
+        ("time", f"{result.elapsed:.2f} s"),
+    ]
+    if result.cables is not None:
+        key.append(
+            (
+                "edge cables",
+                f"{len(result.cables.segments)} segments, EA "
+                f"{number(result.cables.stiffness)}, force {number(result.cable_tension.min())} … "
+                f"{number(result.cable_tension.max())}",
+            )
+        )
+    parts = [
+        "<h2>Erection: on the design shape and after erection</h2>",
+        "<p>The panels welded along their seams, stretched onto the supports and left to settle "
+        "(the same law and yarns; the membrane carries no compression). Membrane forces are "
+        "force per length along the erected yarns; means and RMS are weighted by the design "
+        "area.</p>",
+        table(key, ident="erection"),
+    ]
+    if result.converged:
+        parts += [
+            table(
+                _comparison_rows(result, units),
+                header=("", "on the design shape", "after erection"),
+                ident="erection-comparison",
+            ),
+            *_figures(result, units),
+        ]
+    return parts
+
+
+def write_erection_report(result: ErectionResult, directory: Path, units: str) -> Path:
+    """``report.html`` of an erection on its own, in ``directory``."""
+    parts = page(
+        "erection",
+        "Erection analysis",
+        status_text(result.converged, result.reason),
+        [],
+    )
+    parts += [*erection_section(result, units), "</body></html>"]
+    path = Path(directory) / "report.html"
+    with atomic_path(path) as temporary:
+        temporary.write_text("\n".join(parts), encoding="utf-8")
+    return path

@@ -1,0 +1,83 @@
+"""The pieces every HTML report is made of: the style, tables, inline figures, the page head."""
+
+from __future__ import annotations
+
+import base64
+import datetime
+import html
+import io
+
+from .._version import __version__
+
+__all__ = ["STYLE", "figure", "number", "page", "status_text", "table"]
+
+STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
+h1 { margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; }
+table { border-collapse: collapse; margin: 0.5em 0 1em; }
+td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }
+th { background: #f2f4f7; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+.status-ok { color: #17702a; font-weight: bold; } .status-bad { color: #b00020; font-weight: bold; }
+.warning { background: #fff4d6; border-left: 4px solid #e0a800; padding: 0.4em 0.8em;
+  margin: 0.3em 0; }
+figure { display: inline-block; margin: 0.5em; vertical-align: top; }
+figure img { max-width: 520px; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; color: #555; }
+"""
+
+
+def _png(fig) -> str:
+    import matplotlib.pyplot as plt
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    plt.close(fig)
+    return base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def figure(fig, caption: str, ident: str) -> str:
+    return (
+        f'<figure id="{ident}"><img alt="{html.escape(caption)}" '
+        f'src="data:image/png;base64,{_png(fig)}"><figcaption>{html.escape(caption)}'
+        "</figcaption></figure>"
+    )
+
+
+def table(rows, header=None, ident: str | None = None) -> str:
+    attr = f' id="{ident}"' if ident else ""
+    out = [f"<table{attr}>"]
+    if header:
+        out.append("<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>")
+    for row in rows:
+        cells = []
+        for k, cell in enumerate(row):
+            text = html.escape(str(cell))
+            cells.append(f"<th>{text}</th>" if k == 0 else f'<td class="num">{text}</td>')
+        out.append("<tr>" + "".join(cells) + "</tr>")
+    out.append("</table>")
+    return "".join(out)
+
+
+def number(value: float, digits: int = 5) -> str:
+    return f"{value:.{digits}g}"
+
+
+def page(title: str, heading: str, status: str, warnings: list[str]) -> list[str]:
+    """The head of a report: title, version, date, status and the warnings."""
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>vares report: {html.escape(title)}</title><style>{STYLE}</style>",
+        "</head><body>",
+        f"<h1>{html.escape(heading)}</h1>",
+        f"<p>vares {__version__}, {datetime.datetime.now():%Y-%m-%d %H:%M}. Status: {status}</p>",
+        "<h2>Warnings</h2>",
+    ]
+    if warnings:
+        return parts + [f'<div class="warning">{html.escape(w)}</div>' for w in warnings]
+    return [*parts, "<p id='no-warnings'>None.</p>"]
+
+
+def status_text(converged: bool, reason: str | None) -> str:
+    if converged:
+        return '<span class="status-ok">converged</span>'
+    return f'<span class="status-bad">not converged: {html.escape(str(reason))}</span>'

@@ -1,0 +1,123 @@
+"""Welding panels into one surface, and the boundary of a surface: its loops and corners.
+
+Panels of a structure share their seam nodes in 3D; welded, a seam node is one node of the whole
+surface. :func:`weld` merges the nodes of several meshes that coincide in 3D and returns the
+welded mesh with, for every panel, the welded index of each of its nodes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from .mesh import MeshError, SurfaceMesh
+
+__all__ = ["Welded", "boundary_loops", "corner_nodes", "weld"]
+
+
+class Welded:
+    """Panels welded into one surface: ``mesh`` (cell blocks in panel order), ``node_maps``
+    (per panel, the welded node of each of its nodes) and ``cell_ranges`` (per panel and cell
+    type, the rows of that panel's cells in the welded block)."""
+
+    def __init__(
+        self,
+        mesh: SurfaceMesh,
+        node_maps: list[np.ndarray],
+        cell_ranges: list[dict[str, tuple[int, int]]],
+    ) -> None:
+        self.mesh = mesh
+        self.node_maps = node_maps
+        self.cell_ranges = cell_ranges
+
+
+def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welded:
+    """Weld meshes whose boundary nodes coincide in 3D (within ``tolerance``; default 1e-6 × the
+    structure's size) into one validated surface.
+
+    Only boundary nodes are merged, and only with nodes of other panels. Raises
+    :class:`MeshError` if the welded surface is not a valid surface (e.g. panels oriented
+    oppositely).
+    """
+    if len(meshes) == 1:  # nothing to weld: the mesh as it is
+        mesh = meshes[0]
+        ranges = {t: (0, len(c)) for t, c in mesh.cells.items()}
+        return Welded(mesh, [np.arange(mesh.num_points)], [ranges])
+    points = np.vstack([m.points for m in meshes])
+    offsets = np.cumsum([0] + [m.num_points for m in meshes])
+    size = float(np.ptp(points, axis=0).max()) or 1.0
+    tolerance = 1e-6 * size if tolerance is None else tolerance
+    owner = np.repeat(np.arange(len(meshes)), [m.num_points for m in meshes])
+    candidates = np.concatenate(
+        [offset + np.unique(m.boundary_edges()) for m, offset in zip(meshes, offsets, strict=False)]
+    )
+    pairs = cKDTree(points[candidates]).query_pairs(tolerance, output_type="ndarray")
+    pairs = candidates[pairs]
+    pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
+    n = len(points)
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    # welded node = first node of each group, numbered in order of first appearance
+    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
+    order = np.argsort(first)
+    renumber = np.empty_like(order)
+    renumber[order] = np.arange(len(order))
+    welded_of = renumber[inverse.ravel()]
+    welded_points = np.zeros((len(order), 3))
+    counts = np.bincount(welded_of)
+    for axis in range(3):
+        welded_points[:, axis] = np.bincount(welded_of, weights=points[:, axis]) / counts
+    node_maps = [welded_of[offsets[p] : offsets[p + 1]] for p in range(len(meshes))]
+    blocks: dict[str, list[np.ndarray]] = {}
+    cell_ranges: list[dict[str, tuple[int, int]]] = []
+    for mesh, node_map in zip(meshes, node_maps, strict=True):
+        ranges = {}
+        for cell_type, cells in mesh.cells.items():
+            start = sum(len(b) for b in blocks.get(cell_type, []))
+            blocks.setdefault(cell_type, []).append(node_map[cells])
+            ranges[cell_type] = (start, start + len(cells))
+        cell_ranges.append(ranges)
+    try:
+        mesh = SurfaceMesh(welded_points, {t: np.vstack(b) for t, b in blocks.items()})
+    except MeshError as exc:
+        raise MeshError(f"the welded panels are not one valid surface: {exc}") from None
+    if mesh.num_points != len(welded_points):
+        raise MeshError("the welded panels left nodes without cells")
+    return Welded(mesh, node_maps, cell_ranges)
+
+
+def boundary_loops(mesh: SurfaceMesh) -> list[np.ndarray]:
+    """The boundary of a surface as closed node loops, each in the direction of its cells."""
+    following = {int(a): int(b) for a, b in mesh.boundary_edges()}
+    loops, seen = [], set()
+    for start in sorted(following):
+        if start in seen:
+            continue
+        loop = [start]
+        seen.add(start)
+        node = following[start]
+        while node != start:
+            if node in seen or node not in following:
+                raise MeshError(f"the boundary passes twice through node {node}")
+            loop.append(node)
+            seen.add(node)
+            node = following[node]
+        loops.append(np.array(loop))
+    return loops
+
+
+def corner_nodes(mesh: SurfaceMesh, loop: np.ndarray, angle: float) -> np.ndarray:
+    """The nodes of a boundary loop where the boundary turns by more than ``angle`` degrees
+    (the angle between the incoming and the outgoing boundary edge, in 3D)."""
+    points = mesh.points[loop]
+    incoming = points - np.roll(points, 1, axis=0)
+    outgoing = np.roll(points, -1, axis=0) - points
+    cosine = np.einsum("ij,ij->i", incoming, outgoing) / (
+        np.linalg.norm(incoming, axis=1) * np.linalg.norm(outgoing, axis=1)
+    )
+    turn = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    return loop[turn > angle]

@@ -1,0 +1,162 @@
+"""Where users reach the erection: --erect on the patterning commands, vares erect DIR, job
+files, and the one options model behind them."""
+
+import inspect
+import json
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import vares
+from vares.analysis import ErectionOptions
+from vares.app.cli import app
+from vares.app.job import SECTIONS, load_job
+
+runner = CliRunner()
+FILES = {
+    "erect.json",
+    "erected.vtu",
+    "erected.obj",
+    "deviation.png",
+    "warp_stress.png",
+    "fill_stress.png",
+    "state.png",
+}
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args], env={"COLUMNS": "200"})
+
+
+def error_line(result):
+    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
+def test_pattern_then_erect_the_directory_matches_erect_in_the_same_run(tmp_path):
+    """A mesh file patterned with prestress, then `vares erect DIR`: the same numbers as the API
+    and as `--erect` in the patterning run; flags override the job's [erection] table."""
+    mesh = vares.examples.four_point_sail(n=8)
+    source = tmp_path / "sail.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+    flags = ["--fabric", "pes-pvc-type-2", "--prestress", "2,1.5", "--warp-direction", "1,1,0"]
+    result = run("pattern", source, "-o", tmp_path / "p", *flags, "-q")
+    assert result.exit_code == 0, result.stderr
+    assert (tmp_path / "p" / "job.toml").is_file() and not (tmp_path / "p" / "erect").exists()
+    result = run("erect", tmp_path / "p")
+    assert result.exit_code == 0, result.stderr
+    assert "on the design shape" in result.stderr and "normal deviation" in result.stderr
+    assert {p.name for p in (tmp_path / "p" / "erect").iterdir()} == FILES
+    later = json.loads((tmp_path / "p" / "erect" / "erect.json").read_text())
+    result = run("pattern", source, "-o", tmp_path / "q", *flags, "--erect", "-q")
+    assert result.exit_code == 0, result.stderr
+    same_run = json.loads((tmp_path / "q" / "erect" / "erect.json").read_text())
+    fabric = vares.materials.fabric("pes-pvc-type-2").material()
+    api = vares.erect(
+        vares.solve(vares.read_mesh(source), fabric, warp_direction=(1, 1, 0), prestress=(2, 1.5))
+    ).to_dict()
+    for data in (later, same_run):
+        assert data["converged"] and data["units"] == "m"
+        assert data["deviation"]["max"] == pytest.approx(api["deviation"]["max"], rel=1e-9)
+        for yarn in ("warp", "fill"):
+            for key in ("mean", "min", "max", "intended", "rms_deviation"):
+                assert data["stress"][yarn][key] == pytest.approx(
+                    api["stress"][yarn][key], rel=1e-9
+                )
+    erected = meshio.read(tmp_path / "p" / "erect" / "erected.vtu")
+    np.testing.assert_allclose(
+        np.linalg.norm(erected.point_data["displacement"], axis=1).max(),
+        np.abs(erected.point_data["normal_deviation"]).max(),
+        rtol=0.5,
+    )
+    assert "design_warp_stress" in erected.cell_data and "state" in erected.cell_data
+    # nothing is overwritten without --force; flags override the job's table
+    result = run("erect", tmp_path / "p", "-q")
+    assert result.exit_code == 2 and "output exists" in error_line(result)
+    result = run("erect", tmp_path / "p", "--pressure", "0.05", "--report", "-f", "-q")
+    assert result.exit_code == 0, result.stderr
+    pressed = json.loads((tmp_path / "p" / "erect" / "erect.json").read_text())
+    assert pressed["options"]["pressure"] == 0.05
+    assert pressed["deviation"]["max"] > later["deviation"]["max"]
+    assert "erection-comparison" in (tmp_path / "p" / "erect" / "report.html").read_text()
+
+
+def test_panels_with_erect_weld_the_strips_and_run_again_from_the_saved_job(tmp_path):
+    mesh, ids = vares.examples.hypar_strips(strips=3, cells_per_strip=2, n=8)
+    source = tmp_path / "strips.vtu"
+    cells = [("triangle", mesh.cells["triangle"])]
+    meshio.write(source, meshio.Mesh(mesh.points, cells, cell_data={"panel": [ids]}))
+    out = tmp_path / "strips"
+    result = run(
+        "panels",
+        source,
+        "-o",
+        out,
+        "--fabric",
+        "pes-pvc-type-2",
+        "--prestress",
+        "2,1.5",
+        "--warp-direction",
+        "0,1,0",
+        "--erect",
+        "--cable-stiffness",
+        "5000",
+        "--cable-force",
+        "20",
+        "-q",
+    )
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "erect" / "erect.json").read_text())
+    assert data["converged"] and len(data["panels"]) == 3
+    assert data["nodes"] == mesh.num_points  # the seams are welded: one node each
+    assert data["held_nodes"] == 4 and data["cables"]["force_min"] > 0  # a four-point sail
+    job = load_job(out / "job.toml")
+    assert job.erection == ErectionOptions(cable_stiffness=5000.0, cable_force=20.0)
+    result = run("erect", out, "-f", "-q")  # the saved [erection] table is used again
+    again = json.loads((out / "erect" / "erect.json").read_text())
+    assert result.exit_code == 0 and again["deviation"] == data["deviation"]
+    result = run("run", out / "job.toml", "-o", tmp_path / "rerun", "-q")
+    assert result.exit_code == 0, result.stderr
+    rerun = json.loads((tmp_path / "rerun" / "erect" / "erect.json").read_text())
+    assert rerun["stress"] == data["stress"]
+
+
+def test_run_with_erect_and_clear_errors(tmp_path):
+    job = tmp_path / "job.toml"
+    job.write_text('[input]\nexample = "hypar"\n[output]\ndirectory = "out"\n')
+    result = run("run", job, "--erect", "-q")
+    assert result.exit_code == 0, result.stderr
+    assert json.loads((tmp_path / "out" / "erect" / "erect.json").read_text())["converged"]
+    result = run("example", "hypar", "-o", tmp_path / "x", "--pressure", "1", "-q")
+    assert result.exit_code == 2 and "--pressure is an erection option: add --erect" in (
+        error_line(result)
+    )
+    result = run("erect", tmp_path / "nothing")
+    assert result.exit_code == 2 and "no such directory" in error_line(result)
+    (tmp_path / "empty").mkdir()
+    result = run("erect", tmp_path / "empty")
+    assert result.exit_code == 2 and "no job.toml" in error_line(result)
+    result = run("erect", tmp_path / "out", "--cable-stiffness", "10", "--pressure", "1", "-f")
+    assert result.exit_code == 2 and "not conservative" in error_line(result)
+    result = run("erect", job)
+    assert result.exit_code == 2 and "is a file" in error_line(result)
+    (tmp_path / "out" / "pattern.vtu").write_text("not a mesh\n")  # a damaged output folder
+    result = run("erect", tmp_path / "out", "-f")
+    assert result.exit_code == 2 and "cannot read" in error_line(result)
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[input]\nexample = "hypar"\n[erection]\npresure = 1.0\n')
+    result = run("run", bad, "-q")
+    assert result.exit_code == 2 and "did you mean 'pressure'" in error_line(result)
+
+
+def test_every_erection_option_is_reachable_from_all_three_with_one_default():
+    erect = inspect.signature(vares.erect).parameters
+    for name, spec in ErectionOptions.specs().items():
+        assert spec.section in SECTIONS and SECTIONS[spec.section] == "erection", name
+        assert erect[name].default == ErectionOptions.defaults()[name], name
+        flag = "--" + name.replace("_", "-")
+        for command in ("pattern", "example", "panels", "erect"):
+            assert flag in run(command, "--help").stdout, (name, command)
