@@ -20,7 +20,7 @@ from ..structures.panels import Panel, split_panels
 from ..units import implausible_size
 from .job import Job, JobError
 
-__all__ = ["DEFAULT_UNITS", "Input", "load_input", "safe_name", "saved_patterns"]
+__all__ = ["DEFAULT_UNITS", "Input", "load_input", "safe_name", "saved_patterns", "saved_units"]
 
 #: Units of coordinates when neither the file nor the job names any.
 DEFAULT_UNITS = "m"
@@ -193,6 +193,13 @@ def saved_patterns(job: Job) -> list[Pattern]:
         prestress = job.prestress.value(cell_data)
         patterns.append(Pattern(mesh, coordinates, fibres, prestress, name))
     return patterns
+
+
+def saved_units(job: Job) -> str:
+    """The length units a run stated in its summary (those of the input, or the job's)."""
+    name = "summary.json" if job.structure is None else "structure.json"
+    units = _read_json(job.directory / name).get("units", {})
+    return units.get("length") or job.input.units or DEFAULT_UNITS
 
 
 def safe_name(name: str) -> str:

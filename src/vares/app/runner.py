@@ -27,7 +27,7 @@ from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
 from ..structures.matching import solve_structure
 from .erection_outputs import erection_files, write_erection
-from .inputs import Input, load_input, saved_patterns
+from .inputs import Input, load_input, saved_patterns, saved_units
 from .job import Job, JobError, load_job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import (
@@ -198,6 +198,7 @@ class ErectionRun:
     job: Job
     result: ErectionResult
     files: list[Path] = field(default_factory=list)
+    units: str = "m"
 
 
 def run_erection(
@@ -244,7 +245,7 @@ def run_erection(
         options=options,
         callback=callback,
     )
-    units = job.input.units or "m"
+    units = saved_units(job)
     root = folder.start()
     try:
         staged = write_erection(result, root, units)
@@ -257,7 +258,7 @@ def run_erection(
         folder.discard()
     files = [directory / "erect" / Path(p).relative_to(root) for p in staged]
     add_to_manifest(directory, files)
-    return ErectionRun(job, result, files)
+    return ErectionRun(job, result, files, units)
 
 
 def _panel(

@@ -126,6 +126,7 @@ class SurfaceMesh:
         self._cells = clean
         self._node_map = node_map
         self._edges: _EdgeTable | None = None
+        self._areas: np.ndarray | None = None
         for arr in (self._points, self._node_map, *self._cells.values()):
             arr.setflags(write=False)
         self._validate()
@@ -155,8 +156,12 @@ class SurfaceMesh:
         return sum(len(a) for a in self._cells.values())
 
     def cell_areas(self) -> np.ndarray:
-        """3D area of every cell in global cell order, shape ``(num_cells,)``."""
-        return np.concatenate([ELEMENTS[t].areas(self._points, a) for t, a in self._cells.items()])
+        """3D area of every cell in global cell order, shape ``(num_cells,)`` (read-only)."""
+        if self._areas is None:
+            areas = [ELEMENTS[t].areas(self._points, a) for t, a in self._cells.items()]
+            self._areas = np.concatenate(areas)
+            self._areas.setflags(write=False)
+        return self._areas
 
     @property
     def area(self) -> float:

@@ -3,7 +3,8 @@
 The unknowns are ``d`` numbers per node (dof ``d a + i``): the pattern coordinates (``d = 2``) or
 the erected positions of the forward problem (``d = 3``). Some dofs are held fixed (rigid modes,
 supports); the matrix is assembled directly over the free dofs. The node pattern is built once
-(a sparse sum of the cells' node pairs); every later assembly is a single weighted ``bincount``.
+(a sparse sum of the cells' node pairs), with the matrix slot of every element entry; every
+later assembly adds the element entries into their slots.
 """
 
 from __future__ import annotations
@@ -120,10 +121,15 @@ class Assembler:
 
     def matrix(self, hessians: list[np.ndarray]) -> sp.csr_matrix:
         """Global Hessian over the free dofs (CSR) from per-cell ``(m, nen, d, nen, d)`` blocks."""
-        values = np.concatenate([h.reshape(-1) for h in hessians])
-        data = np.bincount(self._position, weights=values, minlength=self.nnz + 1)[:-1]
+        data = np.zeros(self.nnz + 1)
+        start = 0
+        for h in hessians:  # scatter-add block by block, without a concatenated copy
+            values = h.reshape(-1)
+            _scatter_add(data, self._position[start : start + values.size], values)
+            start += values.size
         return sp.csr_matrix(
-            (data, self._indices, self._indptr), shape=(self.num_free, self.num_free)
+            (data[:-1], self._indices, self._indptr),
+            shape=(self.num_free, self.num_free),
         )
 
 
@@ -157,6 +163,13 @@ def _node_entries(cells, node_ptr, node_col):  # pragma: no cover - compiled
                 out[k] = position
                 k += 1
     return out
+
+
+@njit(cache=True)
+def _scatter_add(data, position, values):  # pragma: no cover - compiled
+    """``data[position[k]] += values[k]`` in order (the same sums as a weighted bincount)."""
+    for k in range(values.size):
+        data[position[k]] += values[k]
 
 
 @njit(cache=True)

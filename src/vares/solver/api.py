@@ -23,7 +23,7 @@ from ..mechanics.problem import Problem
 from ..mechanics.rigid import rigid_modes
 from ..options import split_settings, takes_options
 from .alignment import align_warp, fibre_angle, initial_fibres, rotated
-from .linear import get_solver
+from .linear import get_solver, quiet_blas
 from .newton import Failure, NewtonContext, describe_cells
 from .options import SolveOptions
 from .result import IterationRecord, PatternResult
@@ -83,6 +83,11 @@ def solve(
     if given is not None and isinstance(given, str):
         settings["initial_guess"], given = given, None
     (options,) = split_settings(settings, [options or SolveOptions()])
+    with quiet_blas():
+        return _solve(mesh, material, thickness, prestress, options, callback, given)
+
+
+def _solve(mesh, material, thickness, prestress, options, callback, given) -> PatternResult:
     started = time.perf_counter()
     run = _Run(mesh, material, thickness, prestress, options, callback)
     start = initial_guess(mesh, options, given)

@@ -6,7 +6,8 @@ of one mesh share their sparsity pattern, so a back end that separates the symbo
 fastest first (measured in docs/benchmarks.md):
 
 ``pardiso``
-    Intel MKL PARDISO (pypardiso, optional extra ``vares[pardiso]``), symmetric indefinite mode.
+    Intel MKL PARDISO (pypardiso), symmetric indefinite mode: installed with vares on x86-64
+    Linux and Windows, where MKL has wheels.
 ``cholmod``
     CHOLMOD's Cholesky (scikit-sparse, optional extra ``vares[cholmod]``): nested-dissection
     analysis once per pattern, numeric factorisation per iteration. For positive definite
@@ -32,6 +33,7 @@ __all__ = [
     "SingularMatrixError",
     "available_solvers",
     "get_solver",
+    "quiet_blas",
 ]
 
 
@@ -47,6 +49,16 @@ class LinearSolver(Protocol):
     def factorize(self, matrix: sp.csr_matrix) -> None: ...
 
     def solve(self, rhs: np.ndarray) -> np.ndarray: ...
+
+
+def quiet_blas():
+    """A context in which OpenBLAS (NumPy's and SciPy's) runs on one thread; MKL, which runs
+    PARDISO, keeps its threads. vares' own BLAS calls are on vectors; left multi-threaded,
+    OpenBLAS's worker keeps spinning after each call and takes a core from PARDISO, which then
+    factorises at single-thread speed (docs/benchmarks.md)."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController().select(internal_api="openblas").limit(limits=1)
 
 
 def _finite(x: np.ndarray) -> np.ndarray:
@@ -119,6 +131,12 @@ class PardisoSolver:
     The symbolic analysis (phase 11) is redone only when the sparsity pattern changes; each
     factorisation is the numeric phase 22 alone. All instances share one PARDISO handle (MKL is
     loaded once per process), so solvers must not be used from several threads at once.
+
+    Settings (chosen by measurement, docs/benchmarks.md): minimum-degree ordering below
+    :data:`NESTED_DISSECTION_ABOVE` unknowns (its analysis is 3× faster and its fill no larger
+    on surface meshes), parallel nested dissection above; Bunch–Kaufman pivoting with pivots
+    perturbed below 1e-8 (PARDISO refines a solve itself when it perturbed one); no scaling or
+    matching (the tangent is symmetric and well scaled).
     """
 
     name = "pardiso"
@@ -130,41 +148,64 @@ class PardisoSolver:
 
             _PARDISO = pypardiso.PyPardisoSolver(mtype=-2)
             _PARDISO.set_statistical_info_off()
+            for index, value in _PARDISO_SETTINGS.items():
+                _PARDISO.iparm[index - 1] = value
         self._solver = _PARDISO
         self._matrix = None
+        self._upper = None
 
     def _phase(self, phase: int, rhs: np.ndarray) -> np.ndarray:
-        from pypardiso.pardiso_wrapper import PyPardisoError
+        """One call of PARDISO on the current upper triangle (its 1-based index arrays are made
+        once per pattern, not per call)."""
+        import ctypes
 
-        self._solver.set_phase(phase)
-        try:
-            return self._solver._call_pardiso(self._matrix, rhs)
-        except PyPardisoError as exc:
-            raise SingularMatrixError(f"PARDISO: {exc}") from exc
+        solver = self._solver
+        x = np.zeros_like(rhs)
+        error = ctypes.c_int32(0)
+        int_p, float_p = ctypes.POINTER(ctypes.c_int32), ctypes.POINTER(ctypes.c_double)
+        upper = self._matrix
+        solver._mkl_pardiso(
+            solver.pt.ctypes.data_as(ctypes.POINTER(solver._pt_type[0])),
+            ctypes.byref(ctypes.c_int32(1)),  # maxfct
+            ctypes.byref(ctypes.c_int32(1)),  # mnum
+            ctypes.byref(ctypes.c_int32(solver.mtype)),
+            ctypes.byref(ctypes.c_int32(phase)),
+            ctypes.byref(ctypes.c_int32(upper.shape[0])),
+            upper.data.ctypes.data_as(float_p),
+            self._ia.ctypes.data_as(int_p),
+            self._ja.ctypes.data_as(int_p),
+            solver.perm.ctypes.data_as(int_p),
+            ctypes.byref(ctypes.c_int32(1)),  # one right-hand side
+            solver.iparm.ctypes.data_as(int_p),
+            ctypes.byref(ctypes.c_int32(0)),  # no messages
+            rhs.ctypes.data_as(float_p),
+            x.ctypes.data_as(float_p),
+            ctypes.byref(error),
+        )
+        if error.value != 0:
+            raise SingularMatrixError(f"PARDISO error {error.value}")
+        return x
 
     def factorize(self, matrix: sp.csr_matrix) -> None:
-        # PARDISO needs every diagonal entry stored, even a zero one (a bordered constraint)
-        upper = sp.triu(matrix, format="coo")
-        size = matrix.shape[0]
-        diagonal = np.arange(size)
-        upper = sp.csr_matrix(
-            (
-                np.concatenate([upper.data, np.zeros(size)]),
-                (np.concatenate([upper.row, diagonal]), np.concatenate([upper.col, diagonal])),
-            ),
-            shape=matrix.shape,
-        )
-        upper.sort_indices()
         global _PARDISO_ANALYSED
-        self._matrix = upper
-        self._solver._check_A(upper)
+        size = matrix.shape[0]
+        if self._upper is None or not _same_pattern(self._upper[0], matrix):
+            self._upper = (matrix, *_upper_triangle_map(matrix))
+        _, index, indptr, indices = self._upper
+        # PARDISO needs every diagonal entry stored, even a zero one (a bordered constraint):
+        # the map's index -1 is such an added zero
+        data = np.append(matrix.data, 0.0)[index]
+        self._matrix = sp.csr_matrix((data, indices, indptr), shape=matrix.shape)
+        self._ia = (indptr + 1).astype(np.int32)
+        self._ja = (indices + 1).astype(np.int32)
         empty = np.zeros(size)
-        if _PARDISO_ANALYSED is None or not _same_pattern(_PARDISO_ANALYSED, upper):
+        if _PARDISO_ANALYSED is None or not _same_pattern(_PARDISO_ANALYSED, self._matrix):
             _PARDISO_ANALYSED = None
+            self._solver.iparm[1] = 3 if size > NESTED_DISSECTION_ABOVE else 0  # iparm(2)
             self._phase(11, empty)
-            _PARDISO_ANALYSED = upper
+            _PARDISO_ANALYSED = self._matrix
         self._phase(22, empty)
-        if self._solver.get_iparm(30) != 0:
+        if self._solver.iparm[29] != 0:  # iparm(30): a zero pivot
             raise SingularMatrixError("PARDISO found a zero pivot")
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
@@ -172,6 +213,31 @@ class PardisoSolver:
             raise RuntimeError("factorize() must be called before solve()")
         return _finite(self._phase(33, np.ascontiguousarray(rhs, dtype=float)))
 
+
+def _upper_triangle_map(matrix: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For a CSR matrix with sorted indices, the upper triangle with every diagonal entry
+    stored: ``(index, indptr, indices)`` where ``upper.data = append(matrix.data, 0)[index]``."""
+    n = matrix.shape[0]
+    rows = np.repeat(np.arange(n), np.diff(matrix.indptr))
+    keep = np.flatnonzero(matrix.indices >= rows)
+    has_diagonal = np.zeros(n, dtype=bool)
+    has_diagonal[rows[keep][matrix.indices[keep] == rows[keep]]] = True
+    missing = np.flatnonzero(~has_diagonal)
+    all_rows = np.concatenate([rows[keep], missing])
+    all_cols = np.concatenate([matrix.indices[keep], missing])
+    source = np.concatenate([keep, np.full(missing.size, -1)])
+    order = np.lexsort((all_cols, all_rows))
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(all_rows, minlength=n), out=indptr[1:])
+    return source[order], indptr, all_cols[order]
+
+
+#: PARDISO's iparm (1-based as in its manual): own settings, minimum-degree ordering (changed
+#: per matrix), no iterative refinement unless pivots were perturbed, perturbation 1e-8, no
+#: scaling, no matching, Bunch–Kaufman pivoting.
+_PARDISO_SETTINGS = {1: 1, 2: 0, 8: 0, 10: 8, 11: 0, 13: 0, 21: 1}
+#: PARDISO orders by parallel nested dissection above this many unknowns, else minimum degree.
+NESTED_DISSECTION_ABOVE = 600_000
 
 #: The matrix whose pattern the shared PARDISO handle has analysed.
 _PARDISO_ANALYSED: sp.csr_matrix | None = None
@@ -207,7 +273,7 @@ class CholmodSolver:
         try:
             if self._factor is None or pattern != self._pattern:
                 self._factor = self._cholmod.analyze(
-                    csc, mode="simplicial", ordering_method="nesdis"
+                    csc, mode="supernodal", ordering_method="nesdis"
                 )
                 self._pattern = pattern
             self._factor.cholesky_inplace(csc)

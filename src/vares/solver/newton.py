@@ -186,8 +186,10 @@ def newton(
     step_length, tangent = 0.0, ""
     residuals: list[float] = []
     step_lengths: list[float] = []
+    evaluation = None  # the line search's evaluation of the point it accepted, if it has one
     for iteration in range(ctx.max_iterations + 1):
-        evaluation = problem.evaluate(x, order=2)
+        if evaluation is None:
+            evaluation = problem.evaluate(x, order=2)
         residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
         residual = float(np.linalg.norm(residual_vector))
         initial_residual = residual if initial_residual is None else initial_residual
@@ -228,12 +230,14 @@ def newton(
             raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
         if method == "full":
             x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector)
+            evaluation = None
         elif method == "damped":
             x, step_length, tangent = _damped_step(
                 problem, x, ctx, matrix, residual_vector, evaluation.energy, state
             )
+            evaluation = None
         else:
-            x, step_length, tangent = _line_search_step(
+            x, step_length, tangent, evaluation = _line_search_step(
                 problem, x, ctx, evaluation, matrix, residual_vector, projected
             )
     raise AssertionError("unreachable")
@@ -277,7 +281,11 @@ def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Dampi
 
 def _line_search_step(problem, x, ctx, evaluation, matrix, residual_vector, projected):
     """A globalised step: exact tangent first (projected where that gives no descent), bounded
-    to keep every cell admissible, backtracked until the energy falls enough (Armijo)."""
+    to keep every cell admissible, backtracked until the energy falls enough (Armijo).
+
+    The first trial, usually accepted near the solution, is evaluated with its derivatives: the
+    next iteration needs them. Returns the new point, the step length, the tangent used and that
+    evaluation (``None`` when a shorter step was taken)."""
     for attempt in ("projected",) if projected else ("exact", "projected"):
         if attempt == "projected" and not projected:
             projected = True
@@ -292,10 +300,17 @@ def _line_search_step(problem, x, ctx, evaluation, matrix, residual_vector, proj
         full = np.zeros_like(x)
         full.ravel()[ctx.assembler.free] = delta
         alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
-        for _backtrack in range(40):
+        for backtrack in range(40):
             trial = x + alpha * full
-            energy = problem.energy(trial)
+            at_trial = None
+            if backtrack > 0:
+                energy = problem.energy(trial)
+            elif problem.inverted_cells(trial).size:
+                energy = np.inf
+            else:
+                at_trial = problem.evaluate(trial, order=2)
+                energy = at_trial.energy
             if energy <= evaluation.energy + 1e-4 * alpha * slope + ctx.energy_noise:
-                return trial, alpha, "projected" if projected else "exact"
+                return trial, alpha, "projected" if projected else "exact", at_trial
             alpha *= 0.5
     raise Failure("the line search found no decrease of the energy", x)

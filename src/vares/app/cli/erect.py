@@ -67,7 +67,7 @@ def erect(
             callback=progress(values["quiet"]),
         )
         if not values["quiet"]:
-            show_erection(run.result, run.job.input.units)
+            show_erection(run.result, run.units)
             for path in run.files:
                 console.print(f"  wrote {path}")
         if not run.result.converged:
