@@ -1,13 +1,14 @@
 """vares against libigl's geometric flatteners, side by side on the same meshes.
 
     pip install -e ".[benchmark]"        # libigl (and optionally ".[pardiso]", ".[cholmod]")
-    python benchmarks/flatteners.py --sizes 10000 100000 1000000 --solver pardiso
+    python benchmarks/flatteners.py --sizes 10000 30000 100000 300000 1000000 \
+        --methods vares lscm arap --save scaling.json --plot docs/images/scaling.png
 
 Surfaces: the 10 m × 10 m hyperbolic paraboloid ``z = 0.06 x y`` and the spherical cap of radius
 12 m over the same square, triangulated with about the given number of triangles. Methods:
 
 - ``vares``: ``vares.solve`` with isotropic St. Venant–Kirchhoff (E = 1000, ν = 0.3), default
-  strategy, from scratch (initial guess included) to relative residual 1e-8;
+  strategy and tolerance, from scratch (initial guess included);
 - ``lscm``: ``igl.lscm`` with two boundary vertices pinned at their 3D distance;
 - ``arap``: LSCM start, ``igl.arap_precomputation`` with one pinned vertex, 10 iterations;
 - ``slim``: LSCM start, ``igl.slim_precompute`` (symmetric Dirichlet), 10 iterations.
@@ -70,7 +71,7 @@ def run_method(surface: str, triangles: int, method: str, solver: str | None, ou
         material = vares.materials.StVenantKirchhoff(1000.0, 0.3)
         vares.solve(make_mesh(surface, 50), material, linear_solver=solver)  # warm-up
         start = time.perf_counter()
-        result = vares.solve(mesh, material, tolerance=1e-8, linear_solver=solver)
+        result = vares.solve(mesh, material, linear_solver=solver)
         info["time"] = time.perf_counter() - start
         info["iterations"] = result.iterations
         info["converged"] = result.converged
@@ -149,6 +150,12 @@ def main() -> None:
     parser.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
     parser.add_argument("--solver", default=None, help="vares linear solver (default: fastest)")
     parser.add_argument(
+        "--save", type=Path, help="write every row to this JSON file as it is measured"
+    )
+    parser.add_argument(
+        "--plot", type=Path, help="draw time and peak memory against triangles (log-log) here"
+    )
+    parser.add_argument(
         "--child", nargs=4, metavar=("SURFACE", "SIZE", "METHOD", "OUT"), help=argparse.SUPPRESS
     )
     args = parser.parse_args()
@@ -214,11 +221,58 @@ def main() -> None:
                         **quality,
                     }
                 )
+                if args.save:
+                    args.save.write_text(json.dumps(rows, indent=1))
+    if args.plot:
+        plot(rows, args.plot)
     command = " ".join(
         ["python benchmarks/flatteners.py", "--sizes", *map(str, args.sizes)]
+        + ["--surfaces", *args.surfaces, "--methods", *args.methods]
         + (["--solver", args.solver] if args.solver else [])
     )
     print(f"reproduce: {command}")
+
+
+def plot(rows: list[dict], path: Path) -> None:
+    """Time and peak memory against the number of triangles, log-log, one line per method and
+    surface, with slope-1 guide lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    styles = {"vares": "C0", "lscm": "C2", "arap": "C1", "slim": "C3"}
+    for surface, marker in zip(SURFACES, ("o", "s"), strict=True):
+        for method, colour in styles.items():
+            mine = sorted(
+                (r for r in rows if r["surface"] == surface and r["method"] == method),
+                key=lambda r: r["triangles"],
+            )
+            if not mine:
+                continue
+            n = [r["triangles"] for r in mine]
+            label = f"{method}, {surface}"
+            dashes = "-" if surface == "hypar" else "--"
+            axes[0].loglog(
+                n, [r["time"] for r in mine], dashes, marker=marker, color=colour, label=label
+            )
+            axes[1].loglog(
+                n, [r["peak_mib"] for r in mine], dashes, marker=marker, color=colour, label=label
+            )
+    sizes = np.array(sorted({r["triangles"] for r in rows}), dtype=float)
+    if sizes.size:
+        for axis, key in zip(axes, ("time", "peak_mib"), strict=True):
+            top = max(r[key] for r in rows if r["triangles"] == sizes[-1])
+            axis.loglog(sizes, top * sizes / sizes[-1], ":", color="grey", label="∝ n")
+    axes[0].set(xlabel="triangles", ylabel="wall time (s)", title="time")
+    axes[1].set(xlabel="triangles", ylabel="peak resident memory (MiB)", title="memory")
+    for axis in axes:
+        axis.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    print(f"plot: {path}")
 
 
 if __name__ == "__main__":

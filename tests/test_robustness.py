@@ -1,15 +1,12 @@
-"""Globalised Newton, initial guesses, linear solvers and the robustness suite."""
+"""Globalised Newton, initial guesses and the robustness suite."""
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
 
 import vares
 from vares import examples
 from vares.geometry.flatten import lscm, projection_distortion
 from vares.materials import NeoHooke, NonCrimpFabric, OrthotropicStVenantKirchhoff
-from vares.solver import linear
-from vares.solver.linear import SingularMatrixError, available_solvers, get_solver
 
 NEO_HOOKE = NeoHooke(1000.0, 0.3)
 ORTHO = OrthotropicStVenantKirchhoff(800.0, 640.0, 40.0, 0.4)
@@ -125,53 +122,6 @@ def test_projected_tangent_is_positive_semi_definite():
     a = np.concatenate(problem.evaluate(near).hessians)
     b = np.concatenate(problem.evaluate(near, projected=True).hessians)
     np.testing.assert_allclose(a, b, atol=1e-9 * np.abs(a).max())  # PSD already: unchanged
-
-
-@pytest.mark.parametrize("name", available_solvers())
-def test_linear_solvers_solve_definite_and_bordered_systems(name):
-    rng = np.random.default_rng(4)
-    n = 60
-    m = sp.random(n, n, density=0.08, random_state=4)
-    spd = (m @ m.T + sp.identity(n)).tocsr()
-    solver = get_solver(name)
-    for matrix in (spd, (spd * 2.0).tocsr()):
-        solver.factorize(matrix)
-        rhs = rng.normal(size=n)
-        np.testing.assert_allclose(matrix @ solver.solve(rhs), rhs, atol=1e-10)
-    column = sp.csr_matrix(rng.normal(size=(n, 1)))
-    bordered = sp.bmat([[spd, column], [column.T, None]], format="csr")
-    solver.factorize(bordered)
-    rhs = rng.normal(size=n + 1)
-    np.testing.assert_allclose(bordered @ solver.solve(rhs), rhs, atol=1e-9)
-
-
-@pytest.mark.parametrize("name", available_solvers())
-def test_every_linear_solver_gives_the_same_pattern(name):
-    mesh = examples.hypar(n=10)
-    reference = vares.solve(mesh, ORTHO, warp_angle=20.0, linear_solver="scipy-superlu")
-    result = vares.solve(mesh, ORTHO, warp_angle=20.0, linear_solver=name)
-    assert result.linear_solver == name and result.converged
-    np.testing.assert_allclose(
-        result.material_coordinates, reference.material_coordinates, atol=1e-9
-    )
-
-
-def test_singular_matrices_are_reported():
-    singular = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
-    solver = get_solver("scipy-superlu")
-    with pytest.raises(SingularMatrixError):
-        solver.factorize(singular)
-        solver.solve(np.ones(2))
-
-
-def test_solver_choice_errors(monkeypatch):
-    with pytest.raises(ValueError, match="unknown linear solver"):
-        get_solver("gauss")
-    monkeypatch.setattr(linear, "_importable", lambda module: False)
-    assert available_solvers() == ["scipy-superlu"]
-    with pytest.raises(ValueError, match="not installed"):
-        get_solver("pardiso")
-    assert get_solver().name == "scipy-superlu"
 
 
 @pytest.mark.parametrize("name", list(examples.EXAMPLES))

@@ -21,6 +21,7 @@ from ..analysis.statistics import field_statistics
 from ..io.files import atomic_path
 from ..materials import Hyperelastic
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
+from ..solver.linear import solver_choice
 from .erection_report import erection_section
 from .html_parts import figure, number, page, status_text, table
 from .job import Job
@@ -81,8 +82,8 @@ def _key_figures(outcome: PanelOutcome, unit_names: dict[str, str]) -> list[str]
         ("Newton iterations", result.iterations),
         ("strategy", " → ".join(result.strategy)),
         ("initial guess", result.initial_guess),
-        ("linear solver", result.linear_solver),
-        ("time", f"{result.elapsed:.2f} s"),
+        ("linear solver", solver_choice(result.options.linear_solver, result.linear_solver)),
+        ("time", _time(result)),
     ]
     parts = ["<h2>Key figures</h2>", table(key, ident="key-figures")]
     if not (result.converged or result.overlap is not None):
@@ -105,6 +106,14 @@ def _key_figures(outcome: PanelOutcome, unit_names: dict[str, str]) -> list[str]
             table(outcome.compensation.rows(), header=("", "warp", "fill"), ident="compensation"),
         ]
     return parts
+
+
+def _time(result) -> str:
+    """The solve's wall time, and the kernels' loading before it when there was any."""
+    text = f"{result.elapsed:.2f} s"
+    if result.warm_up >= 0.005:
+        text += f" (and {result.warm_up:.2f} s before it loading the compiled kernels)"
+    return text
 
 
 def _unit(field: str, unit_names: dict[str, str]) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..analysis.statistics import field_statistics
+from ..solver.linear import solver_choice
 from ..solver.result import PatternResult
 
 __all__ = ["summary"]
@@ -28,7 +29,9 @@ def summary(result: PatternResult, **extra: object) -> dict:
         "strategy": result.strategy,
         "options": result.options.to_dict(),
         "linear_solver": result.linear_solver,
+        "linear_solver_choice": solver_choice(result.options.linear_solver, result.linear_solver),
         "elapsed_seconds": result.elapsed,
+        "warm_up_seconds": result.warm_up,
         "mesh": {
             "points": mesh.num_points,
             "cells": {t: len(c) for t, c in mesh.cells.items()},

@@ -84,7 +84,34 @@ def solve(
         settings["initial_guess"], given = given, None
     (options,) = split_settings(settings, [options or SolveOptions()])
     with quiet_blas():
-        return _solve(mesh, material, thickness, prestress, options, callback, given)
+        warm_up = _load_kernels(mesh, material, options.linear_solver)
+        result = _solve(mesh, material, thickness, prestress, options, callback, given)
+    result.warm_up = warm_up
+    return result
+
+
+#: What this process has solved before: ``(cell type, material class, linear solver)``.
+_WARM: set[tuple[str, type, str | None]] = set()
+
+
+def _load_kernels(mesh: SurfaceMesh, material: Hyperelastic, solver: str | None) -> float:
+    """Load (or compile) every compiled kernel a solve of ``mesh`` needs, by solving one cell of
+    each of its cell types, once per process; the seconds it took (0 when nothing was new).
+    Compiled kernels are cached on disk (numba), so only the first process compiles; later ones
+    load them. Kept out of a solve's ``elapsed``."""
+    started = time.perf_counter()
+    for cell_type, cells in mesh.cells.items():
+        key = (cell_type, type(material), solver)
+        if key in _WARM:
+            continue
+        _WARM.add(key)
+        nodes = cells[0]
+        single = SurfaceMesh(mesh.points[nodes], {cell_type: np.arange(len(nodes))[None, :]})
+        try:
+            _solve(single, material, 1.0, None, SolveOptions(linear_solver=solver), None, None)
+        except Exception:  # a warm-up only: the real solve reports any trouble
+            pass
+    return time.perf_counter() - started
 
 
 def _solve(mesh, material, thickness, prestress, options, callback, given) -> PatternResult:

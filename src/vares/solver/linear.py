@@ -34,6 +34,7 @@ __all__ = [
     "available_solvers",
     "get_solver",
     "quiet_blas",
+    "solver_choice",
 ]
 
 
@@ -189,8 +190,8 @@ class PardisoSolver:
     def factorize(self, matrix: sp.csr_matrix) -> None:
         global _PARDISO_ANALYSED
         size = matrix.shape[0]
-        if self._upper is None or not _same_pattern(self._upper[0], matrix):
-            self._upper = (matrix, *_upper_triangle_map(matrix))
+        if self._upper is None or not _same_pattern(self._upper[0], _pattern(matrix)):
+            self._upper = (_pattern(matrix), *_upper_triangle_map(matrix))
         _, index, indptr, indices = self._upper
         # PARDISO needs every diagonal entry stored, even a zero one (a bordered constraint):
         # the map's index -1 is such an added zero
@@ -199,11 +200,13 @@ class PardisoSolver:
         self._ia = (indptr + 1).astype(np.int32)
         self._ja = (indices + 1).astype(np.int32)
         empty = np.zeros(size)
-        if _PARDISO_ANALYSED is None or not _same_pattern(_PARDISO_ANALYSED, self._matrix):
+        if _PARDISO_ANALYSED is None or not _same_pattern(
+            _PARDISO_ANALYSED, _pattern(self._matrix)
+        ):
             _PARDISO_ANALYSED = None
             self._solver.iparm[1] = 3 if size > NESTED_DISSECTION_ABOVE else 0  # iparm(2)
             self._phase(11, empty)
-            _PARDISO_ANALYSED = self._matrix
+            _PARDISO_ANALYSED = _pattern(self._matrix)
         self._phase(22, empty)
         if self._solver.iparm[29] != 0:  # iparm(30): a zero pivot
             raise SingularMatrixError("PARDISO found a zero pivot")
@@ -239,16 +242,21 @@ _PARDISO_SETTINGS = {1: 1, 2: 0, 8: 0, 10: 8, 11: 0, 13: 0, 21: 1}
 #: PARDISO orders by parallel nested dissection above this many unknowns, else minimum degree.
 NESTED_DISSECTION_ABOVE = 600_000
 
-#: The matrix whose pattern the shared PARDISO handle has analysed.
-_PARDISO_ANALYSED: sp.csr_matrix | None = None
+#: The sparsity pattern the shared PARDISO handle has analysed (see :func:`_pattern`).
+_PARDISO_ANALYSED: tuple | None = None
 
 
-def _same_pattern(a: sp.csr_matrix, b: sp.csr_matrix) -> bool:
+def _pattern(matrix: sp.csr_matrix) -> tuple:
+    """A CSR matrix's sparsity pattern ``(shape, indptr, indices)``, without its values."""
+    return matrix.shape, matrix.indptr, matrix.indices
+
+
+def _same_pattern(a: tuple, b: tuple) -> bool:
     return (
-        a.shape == b.shape
-        and a.nnz == b.nnz
-        and np.array_equal(a.indptr, b.indptr)
-        and np.array_equal(a.indices, b.indices)
+        a[0] == b[0]
+        and a[2].size == b[2].size
+        and np.array_equal(a[1], b[1])
+        and np.array_equal(a[2], b[2])
     )
 
 
@@ -323,3 +331,12 @@ def get_solver(name: str | None = None) -> LinearSolver:
             f"available: {', '.join(available)}"
         )
     return _SOLVERS[name]()
+
+
+def solver_choice(requested: str | None, used: str) -> str:
+    """Why ``used`` solved: the words a summary or report gives."""
+    if requested is not None:
+        return f"{used}, as asked"
+    others = [name for name in available_solvers() if name != used]
+    rest = f"; also installed: {', '.join(others)}" if others else ""
+    return f"{used}, the fastest installed{rest}"

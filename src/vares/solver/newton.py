@@ -237,9 +237,10 @@ def newton(
             )
             evaluation = None
         else:
-            x, step_length, tangent, evaluation = _line_search_step(
-                problem, x, ctx, evaluation, matrix, residual_vector, projected
-            )
+            search = _LineSearch(problem, x, ctx, evaluation, matrix, residual_vector, projected)
+            # the search owns the tangent now: it lets go of it before evaluating a trial point
+            del evaluation, matrix, hessians
+            x, step_length, tangent, evaluation = search.step()
     raise AssertionError("unreachable")
 
 
@@ -279,38 +280,55 @@ def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Dampi
     raise Failure("damping could not find an admissible step", x)
 
 
-def _line_search_step(problem, x, ctx, evaluation, matrix, residual_vector, projected):
+class _LineSearch:
     """A globalised step: exact tangent first (projected where that gives no descent), bounded
     to keep every cell admissible, backtracked until the energy falls enough (Armijo).
 
     The first trial, usually accepted near the solution, is evaluated with its derivatives: the
-    next iteration needs them. Returns the new point, the step length, the tangent used and that
-    evaluation (``None`` when a shorter step was taken)."""
-    for attempt in ("projected",) if projected else ("exact", "projected"):
-        if attempt == "projected" and not projected:
-            projected = True
-            matrix = ctx.assembler.matrix(problem.projected_hessians(evaluation))
-        try:
-            delta = ctx.step(matrix, -residual_vector)
-        except SingularMatrixError:
-            continue
-        slope = float(residual_vector @ delta)
-        if not slope < 0:
-            continue
-        full = np.zeros_like(x)
-        full.ravel()[ctx.assembler.free] = delta
-        alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
-        for backtrack in range(40):
-            trial = x + alpha * full
-            at_trial = None
-            if backtrack > 0:
-                energy = problem.energy(trial)
-            elif problem.inverted_cells(trial).size:
-                energy = np.inf
-            else:
-                at_trial = problem.evaluate(trial, order=2)
-                energy = at_trial.energy
-            if energy <= evaluation.energy + 1e-4 * alpha * slope + ctx.energy_noise:
-                return trial, alpha, "projected" if projected else "exact", at_trial
-            alpha *= 0.5
-    raise Failure("the line search found no decrease of the energy", x)
+    next iteration needs them. The element derivatives at ``x`` and the tangent are dropped once
+    a descent direction is found, before that trial is evaluated (two sets of element blocks
+    would be alive at once; at 1M triangles each is about 0.5 GB); they are computed again in
+    the rare case that the exact tangent's direction finds no decrease and the projected one
+    must be tried.
+    """
+
+    def __init__(self, problem, x, ctx, evaluation, matrix, residual_vector, projected) -> None:
+        self.problem, self.x, self.ctx = problem, x, ctx
+        self.evaluation, self.matrix = evaluation, matrix
+        self.energy = evaluation.energy
+        self.residual_vector, self.projected = residual_vector, projected
+
+    def step(self):
+        """``(new point, step length, tangent used, evaluation at the new point or None)``."""
+        problem, x, ctx = self.problem, self.x, self.ctx
+        for attempt in ("projected",) if self.projected else ("exact", "projected"):
+            if attempt == "projected" and not self.projected:
+                self.projected = True
+                if self.evaluation is None:
+                    self.evaluation = problem.evaluate(x, order=2)
+                self.matrix = ctx.assembler.matrix(problem.projected_hessians(self.evaluation))
+            try:
+                delta = ctx.step(self.matrix, -self.residual_vector)
+            except SingularMatrixError:
+                continue
+            slope = float(self.residual_vector @ delta)
+            if not slope < 0:
+                continue
+            self.evaluation = self.matrix = None
+            full = np.zeros_like(x)
+            full.ravel()[ctx.assembler.free] = delta
+            alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
+            for backtrack in range(40):
+                trial = x + alpha * full
+                at_trial = None
+                if backtrack > 0:
+                    energy = problem.energy(trial)
+                elif problem.inverted_cells(trial).size:
+                    energy = np.inf
+                else:
+                    at_trial = problem.evaluate(trial, order=2)
+                    energy = at_trial.energy
+                if energy <= self.energy + 1e-4 * alpha * slope + ctx.energy_noise:
+                    return trial, alpha, "projected" if self.projected else "exact", at_trial
+                alpha *= 0.5
+        raise Failure("the line search found no decrease of the energy", x)

@@ -82,6 +82,11 @@ class PatternResult:
     overlap
         Where the pattern overlaps itself (:class:`vares.geometry.injectivity.Overlap`), when
         it does: such a pattern is not converged (it cannot be cut in one piece).
+    linear_solver, elapsed
+        The sparse solver used and the wall time of the solve (seconds).
+    warm_up
+        Seconds spent before the solve loading the compiled kernels (compiling them, the first
+        time on a machine): 0 once this process has solved a mesh of the same kind.
     """
 
     mesh: SurfaceMesh
@@ -105,6 +110,7 @@ class PatternResult:
     warp_direction: np.ndarray | None = None
     warp_deviation: float | None = None
     overlap: Overlap | None = None
+    warm_up: float = 0.0
     _fields: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     @property

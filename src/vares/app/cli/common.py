@@ -104,12 +104,19 @@ def _compensation_table(report) -> Table:
     return table
 
 
+def _seconds(result) -> str:
+    text = f"{result.elapsed:.2f} s"
+    if result.warm_up >= 0.005:
+        text += f" (+{result.warm_up:.2f} s loading compiled kernels)"
+    return text
+
+
 def _show_panel(panel: PanelOutcome, detail: bool) -> None:
     result = panel.result
     status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
     console.print(
         f"{panel.name}: {status} in {result.iterations} iterations "
-        f"({' → '.join(result.strategy)}), {result.elapsed:.2f} s; energy {result.energy:.6e}; "
+        f"({' → '.join(result.strategy)}), {_seconds(result)}; energy {result.energy:.6e}; "
         f"area 3D {result.surface_area:.6g}, pattern {result.pattern_area:.6g}"
     )
     if result.converged and detail:
