@@ -375,3 +375,33 @@ def test_fabrics_lists_the_presets():
     result = run("fabrics")
     assert result.exit_code == 0
     assert "pes-pvc-type-2" in result.stdout and "typical value" in result.stdout
+
+
+def test_no_previews_writes_everything_but_the_pictures(tmp_path):
+    out = tmp_path / "out"
+    result = run("example", "hypar", "-o", out, "--no-previews")
+    assert result.exit_code == 0, result.stderr
+    written = sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
+    assert "pattern.dxf" in written and "pattern.obj" in written and "summary.json" in written
+    assert "pattern.png" not in written and "pattern.svg" not in written
+    # the job file records the choice, so a rerun of it writes the same files
+    assert "previews = false" in (out / "job.toml").read_text()
+
+
+def test_the_vares_script_exits_with_the_commands_status(tmp_path):
+    import subprocess
+    import sys
+
+    script = "from vares.app.cli import main; main()"
+    ok = subprocess.run(
+        [sys.executable, "-c", script, "fabrics"], capture_output=True, text=True, check=False
+    )
+    assert ok.returncode == 0 and "PES/PVC" in ok.stdout
+    missing = subprocess.run(
+        [sys.executable, "-c", script, "pattern", str(tmp_path / "none.obj"), "-o", tmp_path],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert missing.returncode == 2
+    assert "no such file" in missing.stderr

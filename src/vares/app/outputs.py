@@ -62,6 +62,8 @@ JOB_FILE = "job.toml"
 #: The files of a cut job besides the strips' and the structure's (see app/cut_outputs.py).
 CUT_FILES = ("cut.json", "nest.dxf", "nest.svg", "nest.png", "cut_lines.png", "panels.vtu")
 
+#: The pictures of the pattern (``previews`` in the output options).
+PREVIEW_FILES = ("pattern.svg", "pattern.png")
 PATTERN_FILES = (
     "summary.json",
     "pattern.obj",
@@ -90,7 +92,7 @@ def planned_files(job: Job, source: Input, save_job: Path | None = None) -> list
     files = []
     for panel in [] if job.cut is not None else source.panels:  # a cut's strips come later
         directory = panel_directory(job, panel.name)
-        names = list(PATTERN_FILES)
+        names = [n for n in PATTERN_FILES if job.output.previews or n not in PREVIEW_FILES]
         for field in job.output.plots:
             names += [f"pattern_{field}.svg", f"pattern_{field}.png", f"surface_{field}.png"]
         if job.input.example is not None or job.structure is not None:
@@ -211,6 +213,8 @@ def _label(panel: PanelOutcome, job: Job) -> list[str]:
 
 
 def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> None:
+    if not (job.output.previews or job.output.plots):
+        return  # matplotlib is not even imported
     import matplotlib.pyplot as plt
 
     from ..io.plot import plot_pattern, plot_surface
@@ -227,12 +231,13 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
             panel.files.append(path)
         plt.close(fig)
 
-    save(
-        plot_pattern(
-            mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern", marks=crossings
-        ),
-        ("pattern.svg", "pattern.png"),
-    )
+    if job.output.previews:
+        save(
+            plot_pattern(
+                mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern", marks=crossings
+            ),
+            PREVIEW_FILES,
+        )
     unit = "force/length" if result.thickness == 1.0 else "stress"
     scale = material_scale * result.thickness
     for name in job.output.plots:

@@ -274,6 +274,14 @@ class OutputOptions(Options):
         section="output",
         flags=("--allow-overlap",),
     )
+    previews: bool = option(
+        True,
+        "bool",
+        "Write pattern.svg and pattern.png, pictures of the pattern (matplotlib: most of a "
+        "small job's time).",
+        section="output",
+        flags=("--previews/--no-previews",),
+    )
     plots: tuple[str, ...] = option(
         (),
         "strings",

@@ -21,6 +21,7 @@ fastest first (measured in docs/benchmarks.md):
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Protocol
 
 import numpy as np
@@ -145,6 +146,7 @@ class PardisoSolver:
     def __init__(self) -> None:
         global _PARDISO
         if _PARDISO is None:  # loading MKL takes a while: one handle per process
+            _point_pypardiso_at_mkl()
             import pypardiso
 
             _PARDISO = pypardiso.PyPardisoSolver(mtype=-2)
@@ -215,6 +217,24 @@ class PardisoSolver:
         if self._matrix is None:
             raise RuntimeError("factorize() must be called before solve()")
         return _finite(self._phase(33, np.ascontiguousarray(rhs, dtype=float)))
+
+
+def _point_pypardiso_at_mkl() -> None:
+    """Tell pypardiso where MKL's runtime library is when it lies where MKL's wheel puts it.
+    Left to itself, pypardiso searches the whole environment for it, twice (0.6 s each with a
+    few hundred packages installed: most of a small roof's run)."""
+    import os
+    import site
+    import sys
+
+    if os.environ.get("PYPARDISO_MKL_RT"):
+        return
+    for base in (sys.prefix, site.USER_BASE):
+        for folder, pattern in (("lib", "libmkl_rt.so*"), ("Library/bin", "mkl_rt*.dll")):
+            found = sorted(Path(base, folder).glob(pattern), key=lambda path: len(path.name))
+            if found:
+                os.environ["PYPARDISO_MKL_RT"] = str(found[0])
+                return
 
 
 def _upper_triangle_map(matrix: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
