@@ -9,8 +9,9 @@ the same mesh (numba and libigl code compiled and loaded, memory touched); then 
 ratio. vares solves from scratch every time: from the point and cell arrays (a new
 ``SurfaceMesh``, its checks and cached tables timed), isotropic St. Venant–Kirchhoff, E = 1000,
 ν = 0.3, default strategy and tolerance 1e-10, its sparse solver's symbolic analysis forgotten
-between runs; libigl runs LSCM with two pinned boundary vertices, then ``arap_precomputation`` with one
-pinned vertex and 10 ARAP iterations. Peak memory is the process's (both methods together).
+between runs; libigl runs LSCM with two pinned boundary vertices, then
+``arap_precomputation`` with one pinned vertex and 10 ARAP iterations. Peak memory is the
+process's (both methods together).
 """
 
 from __future__ import annotations

@@ -193,3 +193,41 @@ def test_evaluate_any_pattern():
         rtol=1e-12,
     )
     assert evaluation.fields["energy"].sum() == pytest.approx(evaluation.energy, rel=1e-12)
+
+
+def test_a_minimum_beyond_a_fold_is_named_as_the_reason(monkeypatch):
+    """When a globalised attempt finds the pattern squeezed flat at a cell (its minimum lies
+    beyond a fold), that is the reason given, not the later attempt's iteration limit."""
+    from vares.solver import strategies
+    from vares.solver.newton import Failure
+
+    calls = []
+
+    def fake_newton(problem, x0, ctx, strategy, **_):
+        calls.append(strategy)
+        if strategy == "globalised newton":
+            raise Failure("the pattern is being squeezed flat at 1 cell(s) (7)", x0, folding=True)
+        raise Failure("iteration limit (50) reached", x0)
+
+    class Context:
+        def attempt(self, name, step, tau, run):
+            return run()
+
+    monkeypatch.setattr(strategies, "newton", fake_newton)
+    plan = strategies.plan("auto", 4, have_plane=False)
+    _, path, reason = strategies.follow_plan(None, np.zeros((3, 2)), None, plan, Context(), 1.0)
+    assert calls == ["globalised newton", "damping"] and path == calls
+    assert reason.startswith("the pattern is being squeezed flat at 1 cell(s) (7)")
+
+
+def test_steps_held_back_by_a_fold_are_counted_only_while_they_shrink():
+    from vares.solver.newton import _held_back
+
+    class Search:
+        bounded_by = np.array([7])
+
+    assert _held_back(Search(), 0.03, [1.0, 0.3])
+    assert not _held_back(Search(), 0.2, [1.0, 0.3])  # not short
+    assert not _held_back(Search(), 0.03, [0.04])  # not shorter than half the one before
+    Search.bounded_by = None
+    assert not _held_back(Search(), 0.03, [1.0, 0.3])  # not held back by a fold

@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 import vares
 from vares.app.cli import app
 from vares.geometry.examples import hypar, ruffled_fan
-from vares.geometry.flatten import inverted_cells, lscm, tutte
+from vares.geometry.flatten import inverted_cells, lscm, tutte, untangle
 from vares.geometry.injectivity import pattern_overlap
 from vares.io.meshes import write_surface
 
@@ -33,9 +33,39 @@ def test_tutte_is_one_to_one_where_the_conformal_map_folds():
     start = tutte(mesh)
     assert inverted_cells(mesh, start).size == 0 and pattern_overlap(mesh, start) is None
     assert vares.geometry.signed_area(mesh, start) == pytest.approx(mesh.area)
-    with pytest.warns(UserWarning, match="the conformal map folds 2 cell.*Tutte's embedding"):
+    # the two folds are mended where they are; the minimum found from there laps over itself,
+    # and the solve starts again from Tutte's embedding
+    with pytest.warns(UserWarning, match="the conformal map folds 2 cell.*mended where they are"):
         result = vares.solve(mesh, NEO_HOOKE)
     assert result.converged and result.initial_guess == "tutte"
+    assert "restart from Tutte's embedding" in result.strategy
+
+
+def test_a_few_folded_cells_are_mended_where_they_are():
+    mesh = hypar(n=12)
+    start = mesh.points[:, :2].copy()
+    node = 6 * 13 + 6  # an inner node pushed across two of its neighbours: its cells fold
+    start[node] += [1.3, 0.9]
+    folded = inverted_cells(mesh, start)
+    assert folded.size >= 2
+    mended = untangle(mesh, start)
+    assert mended is not None and inverted_cells(mesh, mended).size == 0
+    moved = np.flatnonzero(np.any(mended != start, axis=1))
+    assert node in moved
+    # only the neighbourhood moved: every moved node within a few cells of the folded node
+    assert np.abs(mesh.points[moved, :2] - mesh.points[node, :2]).max() <= 5 * 10.0 / 12
+    assert untangle(mesh, mesh.points[:, :2]) is not None  # nothing folded: unchanged
+    # a start one gives is never changed behind one's back: it is refused
+    given = vares.solve(mesh, NEO_HOOKE, initial_guess=start)
+    assert not given.converged and "the initial guess inverts" in given.reason
+
+
+def test_a_fold_held_by_the_boundary_is_not_mended():
+    mesh = hypar(n=8)
+    start = mesh.points[:, :2].copy()
+    start[0] += [3.0, 3.0]  # a corner node thrown inside: its cell folds, and it is held
+    assert inverted_cells(mesh, start).size
+    assert untangle(mesh, start) is None
 
 
 def test_tutte_on_a_surface_with_a_hole():

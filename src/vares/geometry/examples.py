@@ -13,6 +13,10 @@
 ``saddle``, ``conic-tent``
     Whole membranes to cut into strips of roll width: a four-point sail over a 20 m square, and
     a conic tent all round its high ring.
+``scan_like``, ``cad_roof_mm``
+    Surfaces as they come from outside (the real-world-like set): a scanned organic shell with
+    rough random triangles and measurement noise, and a membrane roof exported from CAD in
+    millimetres with long thin triangles.
 ``rib30``
     A generic 30° segment of a curved composite rib (seed §5.2): a hat-shaped cross-section
     (web, inclined walls, flanges, rounded corners) swept along a circular arc. The rounded
@@ -27,7 +31,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .mesh import SurfaceMesh
+from .mesh import SurfaceMesh, connected_pieces
 
 __all__ = [
     "CUT_EXAMPLES",
@@ -36,6 +40,7 @@ __all__ = [
     "PANEL_NAMES",
     "STRUCTURE_EXAMPLES",
     "bumpy",
+    "cad_roof_mm",
     "cap_over_square",
     "catenoid_band",
     "catenoid_section",
@@ -49,10 +54,12 @@ __all__ = [
     "hypar",
     "hypar_strips",
     "irregular_hypar_strips",
+    "real_world_suite",
     "rib30",
     "robustness_suite",
     "ruffled_fan",
     "saddle",
+    "scan_like",
     "spherical_cap",
     "tent_roof",
 ]
@@ -573,6 +580,86 @@ def robustness_suite(fine: bool = False) -> dict[str, Callable[[], SurfaceMesh]]
             cell_type="quad", **({} if fine else {"spacing": 0.02, "fillet_segments": 3})
         ),
     }
+
+
+def scan_like(
+    triangles: int = 20_000,
+    size: float = 6.0,
+    noise: float = 0.002,
+    seed: int = 0,
+) -> SurfaceMesh:
+    """A scanned organic shell: about ``triangles`` rough triangles on jittered points (sizes
+    and angles vary as in a scan, slivers included) inside a wavy outline ``size`` across,
+    a double-curved surface of bumps, a dome and a twist, with Gaussian measurement noise of
+    standard deviation ``noise`` on every point (metres)."""
+    from scipy.spatial import Delaunay
+
+    rng = np.random.default_rng(seed)
+    # a jittered grid: irregular triangles of every shape, slivers included, as a scanner's
+    # meshing software leaves them, but no two points closer than a fifth of the spacing
+    area = np.pi * 0.7 * (size / 2) ** 2 * 1.0126  # the wavy outline's area
+    spacing = np.sqrt(4 * area / (np.sqrt(3) * triangles))  # equilateral triangles' side
+    rows = np.arange(-size / 2, size / 2 + spacing, spacing * np.sqrt(3) / 2)
+    columns = np.arange(-size / 2, size / 2 + spacing, spacing)
+    gx, gy = np.meshgrid(columns, rows, indexing="xy")
+    gx = gx + (np.arange(rows.size)[:, None] % 2) * spacing / 2
+    points = np.column_stack([gx.ravel(), gy.ravel()])
+    points += rng.uniform(-0.4, 0.4, points.shape) * spacing
+    angle = np.arctan2(points[:, 1] / 0.7, points[:, 0])
+    wavy = 1.0 + 0.12 * np.sin(3 * angle + 0.4) + 0.07 * np.cos(5 * angle)
+    points = points[np.hypot(points[:, 0], points[:, 1] / 0.7) < wavy * size / 2 - spacing / 2]
+    rim_points = int(2 * np.pi * 0.85 * size / 2 * 1.1 / spacing)
+    rim = np.linspace(0.0, 2 * np.pi, rim_points, endpoint=False)
+    rim_wavy = 1.0 + 0.12 * np.sin(3 * rim + 0.4) + 0.07 * np.cos(5 * rim)
+    outline = np.column_stack([np.cos(rim), 0.7 * np.sin(rim)]) * rim_wavy[:, None] * (size / 2)
+    plane = np.vstack([points, outline])
+    triangles_ = Delaunay(plane).simplices
+    # keep the wavy outline (Delaunay fills its convex hull): drop triangles across the bays
+    centroid = plane[triangles_].mean(axis=1)
+    theta = np.arctan2(centroid[:, 1] / 0.7, centroid[:, 0])
+    reach = (1.0 + 0.12 * np.sin(3 * theta + 0.4) + 0.07 * np.cos(5 * theta)) * (size / 2)
+    inside = np.hypot(centroid[:, 0], centroid[:, 1] / 0.7) < reach * 0.995
+    triangles_ = triangles_[inside]
+    x, y = plane[:, 0] / size, plane[:, 1] / size
+    z = size * (
+        0.12 * (1.0 - 2.0 * (x**2 + y**2))
+        + 0.05 * x * y * 8.0
+        + 0.03 * np.exp(-((x - 0.2) ** 2 + (y + 0.1) ** 2) / 0.01)
+        - 0.025 * np.exp(-((x + 0.25) ** 2 + (y - 0.15) ** 2) / 0.006)
+    )
+    points3 = np.column_stack([plane, z]) + rng.normal(0.0, noise, (plane.shape[0], 3))
+    # one piece (a triangle at the rim may hang on by a corner) and no points left outside
+    triangles_ = triangles_[connected_pieces(points3, {"triangle": triangles_}) == 0]
+    used, cells = np.unique(triangles_, return_inverse=True)
+    return SurfaceMesh(points3[used], {"triangle": cells.reshape(-1, 3)})
+
+
+def cad_roof_mm(span: float = 12_000.0, depth: float = 8_000.0, n: int = 48) -> SurfaceMesh:
+    """A membrane roof as a CAD program exports it, in millimetres: a saddle over
+    ``span`` × ``depth`` mm with two high corners 1.8 m up, meshed in long strips (cells 8:1 to
+    40:1 long against wide, every diagonal the same way) graded towards the edges."""
+    u = np.linspace(-1.0, 1.0, n + 1)
+    v = np.sin(np.linspace(-np.pi / 2, np.pi / 2, max(4, n // 6) + 1))
+    x, y = np.meshgrid(u * span / 2, v * depth / 2, indexing="xy")
+    z = 1_800.0 * (x / (span / 2)) * (y / (depth / 2)) + 600.0 * (1 - (x / (span / 2)) ** 2)
+    points = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    return SurfaceMesh(points, grid_cells(n + 1, v.size, "triangle"))
+
+
+def real_world_suite(large: bool = False) -> dict[str, tuple[Callable[[], SurfaceMesh], str]]:
+    """Surfaces as they come from outside, each with the units of its coordinates: a scan, a
+    coarse scan, a CAD roof in millimetres and, with ``large``, a 300k-triangle scan."""
+    suite = {
+        "scan, 20k rough triangles, 2 mm noise": (lambda: scan_like(20_000), "m"),
+        "scan, 3k triangles, 5 mm noise": (lambda: scan_like(3_000, noise=0.005, seed=1), "m"),
+        "CAD roof in mm, strips 40:1": (lambda: cad_roof_mm(), "mm"),
+    }
+    if large:
+        suite["scan, 300k triangles, 0.5 mm noise"] = (
+            lambda: scan_like(300_000, noise=0.0005, seed=2),
+            "m",
+        )
+    return suite
 
 
 #: Example generators by name (used by ``vares example``).

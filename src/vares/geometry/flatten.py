@@ -26,7 +26,9 @@ __all__ = [
     "projection_distortion",
     "projection_plane",
     "signed_area",
+    "squashed_share",
     "tutte",
+    "untangle",
 ]
 
 _NAMED_PLANES = {
@@ -212,14 +214,29 @@ def projection_distortion(mesh: SurfaceMesh, plane: ProjectionPlane) -> float:
     Evaluated where ``det J`` is checked (a triangle's single value, a quad's corners): 1 for a
     surface parallel to the plane, ``cos θ`` where the surface is inclined by ``θ``.
     """
+    return float(_projected_area_ratios(mesh, plane)[0].min())
+
+
+def squashed_share(mesh: SurfaceMesh, plane: ProjectionPlane, ratio: float) -> float:
+    """The share of the surface's area whose projection onto ``plane`` keeps less than
+    ``ratio`` of its area (or folds): where the surface is steeper than ``arccos(ratio)``. A
+    few noisy slivers of a scan weigh nothing here, unlike in :func:`projection_distortion`."""
+    ratios, areas = _projected_area_ratios(mesh, plane)
+    return float(areas[ratios < ratio].sum() / areas.sum())
+
+
+def _projected_area_ratios(mesh: SurfaceMesh, plane: ProjectionPlane):
+    """Projected / 3D area element at every check point, and the 3D area it stands for."""
     coordinates = plane.project(mesh.points)
-    ratios = []
+    ratios, areas = [], []
     for cell_type, cells in mesh.cells.items():
         element = ELEMENTS[cell_type]
         j = element.jacobians(coordinates, cells, at="check")
         det = j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
-        ratios.append((det / element.corner_areas(mesh.points, cells)).ravel())
-    return float(np.concatenate(ratios).min())
+        corner = element.corner_areas(mesh.points, cells)
+        ratios.append((det / corner).ravel())
+        areas.append(np.broadcast_to(corner, det.shape).ravel())
+    return np.concatenate(ratios), np.concatenate(areas)
 
 
 def tutte(mesh: SurfaceMesh) -> np.ndarray:
@@ -257,6 +274,67 @@ def tutte(mesh: SurfaceMesh) -> np.ndarray:
         area = -area
     coordinates -= coordinates.mean(axis=0)
     return coordinates * np.sqrt(mesh.area / area)
+
+
+def untangle(
+    mesh: SurfaceMesh, coordinates: np.ndarray, rings: tuple[int, ...] = (1, 2, 3, 5, 8)
+) -> np.ndarray | None:
+    """A pattern whose few folded cells are mended where they are: the nodes within ``k`` rings
+    of cells around them are placed again as the mean-value-weighted average of their
+    neighbours (Tutte's embedding of that patch, its rim and the mesh boundary held), for each
+    ``k`` of ``rings`` in turn until no cell folds. The rest of the pattern is untouched: a
+    rough scan's projection with a few flipped slivers stays as close to the optimum as it was,
+    where Tutte's embedding of the whole would start far from it. ``None`` when the folds
+    persist (one held on the boundary, or too many); the input when nothing folds.
+    """
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    inverted = inverted_cells(mesh, coordinates)
+    if not inverted.size:
+        return coordinates
+    n = mesh.num_points
+    rows, cols, weights = _mean_value_weights(mesh.points, _triangles(mesh))
+    laplacian = sp.csr_matrix((weights, (rows, cols)), shape=(n, n))
+    laplacian = (sp.diags(np.asarray(laplacian.sum(axis=1)).ravel()) - laplacian).tocsr()
+    blocks = list(mesh.cells.values())
+    cell_nodes = [block.ravel() for block in blocks]
+    owner = np.concatenate(
+        [offset + np.repeat(np.arange(len(b)), b.shape[1]) for offset, b in _offsets(blocks)]
+    )
+    incidence = sp.csr_matrix(
+        (np.ones(owner.size), (owner, np.concatenate(cell_nodes))), shape=(mesh.num_cells, n)
+    )
+    held = np.zeros(n, dtype=bool)
+    for loop in mesh.boundary_loops():
+        held[loop] = True
+    patch = np.zeros(n, dtype=bool)
+    patch[np.unique(incidence[inverted].indices)] = True
+    grown = 0
+    for ring in rings:
+        while grown < ring:  # one more ring of cells: every node of a cell touching the patch
+            cells = np.flatnonzero(incidence @ patch.astype(float))
+            inner, patch = patch, np.zeros(n, dtype=bool)
+            patch[np.unique(incidence[cells].indices)] = True
+            grown += 1
+        free = np.flatnonzero(inner & ~held)
+        if not free.size:
+            continue
+        fixed = np.flatnonzero(~np.isin(np.arange(n), free))
+        trial = coordinates.copy()
+        system = laplacian[free][:, free].tocsc()
+        rhs = -laplacian[free][:, fixed] @ coordinates[fixed]
+        trial[free] = np.column_stack([spsolve(system, rhs[:, k]) for k in range(2)])
+        if not inverted_cells(mesh, trial).size:
+            return trial
+    return None
+
+
+def _offsets(blocks: list[np.ndarray]):
+    offset = 0
+    for block in blocks:
+        yield offset, block
+        offset += len(block)
 
 
 def _loop_length(points: np.ndarray, loop: np.ndarray) -> float:

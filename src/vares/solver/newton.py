@@ -50,10 +50,11 @@ class Failure(Exception):
     """A Newton iteration (or a strategy) did not converge; ``coordinates`` is where it stopped
     (never inverted)."""
 
-    def __init__(self, reason: str, coordinates: np.ndarray) -> None:
+    def __init__(self, reason: str, coordinates: np.ndarray, folding: bool = False) -> None:
         super().__init__(reason)
         self.reason = reason
         self.coordinates = coordinates
+        self.folding = folding  # the energy's minimum lies beyond a fold: no strategy helps
 
 
 def describe_cells(ids: np.ndarray, limit: int = 5) -> str:
@@ -187,6 +188,7 @@ def newton(
     residuals: list[float] = []
     step_lengths: list[float] = []
     evaluation = None  # the line search's evaluation of the point it accepted, if it has one
+    squeezed = 0  # iterations in a row whose steps a fold held back, each shorter
     for iteration in range(ctx.max_iterations + 1):
         if evaluation is None:
             evaluation = problem.evaluate(x, order=2)
@@ -241,6 +243,15 @@ def newton(
             # the search owns the tangent now: it lets go of it before evaluating a trial point
             del evaluation, matrix, hessians
             x, step_length, tangent, evaluation = search.step()
+            squeezed = squeezed + 1 if _held_back(search, step_length, step_lengths) else 0
+            if squeezed >= SQUEEZED_ITERATIONS:
+                raise Failure(
+                    f"the pattern is being squeezed flat at {describe_cells(search.bounded_by)}: "
+                    "the energy's minimum would fold them (the pattern would lap over itself "
+                    "there); cut the surface there (split it into panels) or add a dart",
+                    x,
+                    folding=True,
+                )
     raise AssertionError("unreachable")
 
 
@@ -280,6 +291,22 @@ def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Dampi
     raise Failure("damping could not find an admissible step", x)
 
 
+#: After this many iterations in a row whose steps shrink (each below a tenth, each less than
+#: half the one before) because a cell would fold, the line search gives up.
+SQUEEZED_ITERATIONS = 6
+
+
+def _held_back(search: _LineSearch, step_length: float, step_lengths: list[float]) -> bool:
+    """Whether this step was held back by a fold, and shorter than half the one before."""
+    previous = step_lengths[-1] if step_lengths else 1.0
+    return (
+        search.bounded_by is not None
+        and search.bounded_by.size > 0
+        and step_length < 0.1
+        and step_length < 0.5 * previous
+    )
+
+
 class _LineSearch:
     """A globalised step: exact tangent first (projected where that gives no descent), bounded
     to keep every cell admissible, backtracked until the energy falls enough (Armijo).
@@ -297,6 +324,8 @@ class _LineSearch:
         self.evaluation, self.matrix = evaluation, matrix
         self.energy = evaluation.energy
         self.residual_vector, self.projected = residual_vector, projected
+        #: the cells that would fold just beyond the step, when they bounded it
+        self.bounded_by: np.ndarray | None = None
 
     def step(self):
         """``(new point, step length, tangent used, evaluation at the new point or None)``."""
@@ -317,7 +346,11 @@ class _LineSearch:
             self.evaluation = self.matrix = None
             full = np.zeros_like(x)
             full.ravel()[ctx.assembler.free] = delta
-            alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
+            bound = problem.admissible_step(x, full)
+            alpha = min(1.0, 0.9 * bound)
+            self.bounded_by = (
+                problem.inverted_cells(x + min(1.0, 1.01 * bound) * full) if bound < 1 else None
+            )
             for backtrack in range(40):
                 trial = x + alpha * full
                 at_trial = None

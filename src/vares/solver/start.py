@@ -18,9 +18,10 @@ from ..geometry.flatten import (
     ProjectionPlane,
     inverted_cells,
     lscm,
-    projection_distortion,
     projection_plane,
+    squashed_share,
     tutte,
+    untangle,
 )
 from ..geometry.mesh import SurfaceMesh
 from ..options import OptionsError
@@ -28,8 +29,13 @@ from .options import SolveOptions
 
 __all__ = ["PROJECTION_MIN_AREA_RATIO", "Start", "initial_guess"]
 
-#: Below this smallest projected/3D area ratio (about 78° of slope) the projection is no start.
+#: Where the projection keeps less than this of the area (slopes above 78°) it squashes the
+#: pattern; when more than :data:`STEEP_SHARE` of the surface is so steep, the conformal map
+#: is the better start.
 PROJECTION_MIN_AREA_RATIO = 0.2
+STEEP_SHARE = 0.01
+#: A start folding more cells than this is not mended locally (the next start is tried).
+MEND_AT_MOST = 1000
 _NAMES = {"projection": "the projection", "lscm": "the conformal map", "tutte": "Tutte's embedding"}
 
 
@@ -49,17 +55,18 @@ def initial_guess(
     """The start that ``options.initial_guess`` asks for, or the ``given`` coordinates.
 
     ``"auto"`` takes the projection onto ``options.plane``, unless no plane is named and the
-    best-fit projection flattens a cell below :data:`PROJECTION_MIN_AREA_RATIO` of its area;
-    then the conformal map. Whichever of these folds a cell is passed over (with a warning) for
-    the next, down to Tutte's embedding (not with pseudo-time stepping, whose path needs the
-    projection).
+    best-fit projection flattens more than :data:`STEEP_SHARE` of the surface below
+    :data:`PROJECTION_MIN_AREA_RATIO` of its area; then the conformal map. One that folds up to
+    :data:`MEND_AT_MOST` cells is mended where it folds (:func:`untangle`); one that still folds
+    is passed over (with a warning) for the next, down to Tutte's embedding (not with
+    pseudo-time stepping, whose path needs the projection).
     """
     if given is not None:
         return _given(mesh, options, given)
     plane = projection_plane(mesh, options.plane)
     if options.initial_guess != "auto":
         return _make(mesh, options.initial_guess, plane)
-    steep = projection_distortion(mesh, plane) < PROJECTION_MIN_AREA_RATIO
+    steep = squashed_share(mesh, plane, PROJECTION_MIN_AREA_RATIO) > STEEP_SHARE
     order = ["projection", "lscm", "tutte"]
     if options.strategy == "pseudo-time":
         order = ["projection"]
@@ -69,6 +76,13 @@ def initial_guess(
     for kind in order:
         start = _make(mesh, kind, plane)
         inverted = inverted_cells(mesh, start.coordinates)
+        if inverted.size and kind != "tutte" and inverted.size <= MEND_AT_MOST:
+            mended = untangle(mesh, start.coordinates)
+            if mended is not None:
+                folded.append(
+                    f"{_NAMES[kind]} folds {inverted.size} cell(s), mended where they are"
+                )
+                start, inverted = Start(mended, kind, start.plane), inverted[:0]
         if not inverted.size:
             if folded:
                 warnings.warn(f"{'; '.join(folded)}: started from {_NAMES[kind]}", stacklevel=3)

@@ -80,7 +80,7 @@ def follow_plan(
     failure or None)``. A whole-surface attempt goes on from where the last one stopped (never
     inverted, lower energy than the start); pseudo-time stepping starts again from ``start``."""
     path: list[str] = []
-    reason = None
+    reason = folding = None
     x = resume = start
     for attempt in attempts:
         path.append(attempt.name)
@@ -106,9 +106,12 @@ def follow_plan(
             return x, path, None
         except Failure as failure:
             reason, x = failure.reason, failure.coordinates
+            if failure.folding:
+                folding = failure.reason
             if attempt.taus is None:
                 resume = x
-    return x, path, reason
+    # a minimum beyond a fold explains the later attempts' failures better than they do
+    return x, path, folding or reason
 
 
 def pseudo_time(
