@@ -56,10 +56,13 @@ def initial_guess(
 
     ``"auto"`` takes the projection onto ``options.plane``, unless no plane is named and the
     best-fit projection flattens more than :data:`STEEP_SHARE` of the surface below
-    :data:`PROJECTION_MIN_AREA_RATIO` of its area; then the conformal map. One that folds up to
-    :data:`MEND_AT_MOST` cells is mended where it folds (:func:`untangle`); one that still folds
-    is passed over (with a warning) for the next, down to Tutte's embedding (not with
-    pseudo-time stepping, whose path needs the projection).
+    :data:`PROJECTION_MIN_AREA_RATIO` of its area; then the conformal map. A projection that
+    folds up to :data:`MEND_AT_MOST` cells (a scan's noisy slivers, a local overhang) is mended
+    where it folds (:func:`untangle`). A start that still folds is passed over (with a warning)
+    for the next, down to Tutte's embedding (not with pseudo-time stepping, whose path needs the
+    projection). The conformal map is not mended: where it folds, it is distorted far around
+    (a steep saddle mended from it ended in a minimum that laps over itself, found again from
+    Tutte's embedding at twice the cost).
     """
     if given is not None:
         return _given(mesh, options, given)
@@ -76,7 +79,7 @@ def initial_guess(
     for kind in order:
         start = _make(mesh, kind, plane)
         inverted = inverted_cells(mesh, start.coordinates)
-        if inverted.size and kind != "tutte" and inverted.size <= MEND_AT_MOST:
+        if inverted.size and kind == "projection" and inverted.size <= MEND_AT_MOST:
             mended = untangle(mesh, start.coordinates)
             if mended is not None:
                 folded.append(
