@@ -352,6 +352,11 @@ def test_job_files_run_save_and_report_bad_keys(tmp_path):
         ("picture.obj", b"\x89PNG\r\n\x1a\n" + bytes(range(256))),
         ("nan.obj", b"v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n"),
         ("broken.vtu", b"<?xml version='1.0'?><VTKFile type='UnstructuredGrid'><Unstr"),
+        ("inf.obj", b"v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n"),
+        ("points.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
+        ("lines.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n"),
+        ("range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+        ("collinear.obj", b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
     ],
 )
 def test_bad_files_fail_in_one_line_and_leave_no_output(tmp_path, name, content):
@@ -363,4 +368,5 @@ def test_bad_files_fail_in_one_line_and_leave_no_output(tmp_path, name, content)
     assert "Traceback" not in result.stdout + result.stderr
     lines = [x for x in result.stderr.splitlines() if x.strip()]
     assert len(lines) == 1 and lines[0].startswith("vares: error:"), result.stderr
+    assert name in lines[0]  # the message names the file
     assert not out.exists() or not any(out.iterdir())

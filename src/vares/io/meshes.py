@@ -150,7 +150,18 @@ def read_mesh_file(path: str | Path, *, repair: bool = True) -> MeshFile:
     """Read and (unless ``repair`` is false) repair a mesh file; see :class:`MeshFile`."""
     path = Path(path)
     raw = read_raw(path)
-    fixed = repair_surface(raw.points, raw.cells, raw.polygons, weld=repair)
+    try:
+        fixed = repair_surface(raw.points, raw.cells, raw.polygons, weld=repair)
+    except MeshError as exc:
+        raise MeshError(f"{path}: {exc}") from None
+    given = sum(len(c) for c in raw.cells.values()) + len(raw.polygons or [])
+    if given and not fixed.cells:
+        report = fixed.report
+        raise MeshError(
+            f"{path}: every one of its {given} cell(s) is collapsed (no area) or a duplicate "
+            f"({report.collapsed_cells} collapsed, {report.duplicate_cells} duplicate, "
+            f"{report.flat_boundary_cells} flat on the boundary): nothing is left to pattern"
+        )
     cell_data = {name: np.asarray(values)[fixed.cell_map] for name, values in raw.cell_data.items()}
     return MeshFile(
         path, fixed.points, fixed.cells, cell_data, raw.units, raw.resolution, fixed.report
