@@ -50,15 +50,12 @@ def run_vares(mesh, solver: str | None) -> tuple[float, dict]:
 
 def run_arap(mesh) -> tuple[float, dict]:
     import igl
+    from flatteners import pins  # the same LSCM pins as the flatteners benchmark
 
     points = np.ascontiguousarray(mesh.points)
     faces = np.ascontiguousarray(mesh.cells["triangle"], dtype=np.int64)
     start = time.perf_counter()
-    boundary = igl.boundary_loop(faces)
-    first = boundary[0]
-    second = boundary[np.argmax(np.linalg.norm(points[boundary] - points[first], axis=1))]
-    pinned = np.array([first, second], dtype=np.int64)
-    values = np.array([[0.0, 0.0], [np.linalg.norm(points[second] - points[first]), 0.0]])
+    pinned, values = pins(points, faces)
     uv, _ = igl.lscm(points, faces, pinned, values)
     data = igl.ARAPData()
     data.max_iter = 10
