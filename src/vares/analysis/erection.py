@@ -222,7 +222,7 @@ def erect(
         cables=structure.cables,
         pressure=options.pressure,
     )
-    ctx = _context(problem, held, solver, callback)
+    ctx = _context(problem, held, solver, callback, options.erection_iterations)
     x, path, reason = design.copy(), [], None
     if start is not None:
         x[~held] = _checked_start(start, design)[~held]
@@ -280,8 +280,11 @@ def _defaults(source, material, thickness, solver):
     return material, thickness, solver
 
 
-def _context(problem: ErectionProblem, held, solver: SolveOptions, callback) -> NewtonContext:
-    """The Newton context of an erection: supports held, the solve's tolerance and limits."""
+def _context(
+    problem: ErectionProblem, held, solver: SolveOptions, callback, max_iterations: int
+) -> NewtonContext:
+    """The Newton context of an erection: supports held, the solve's tolerance and linear
+    solver, the erection's own iteration limit."""
     material = problem.material
     return NewtonContext(
         assembler=Assembler(problem.connectivity, np.repeat(~held, 3), dofs_per_node=3),
@@ -292,7 +295,7 @@ def _context(problem: ErectionProblem, held, solver: SolveOptions, callback) -> 
         * problem.thickness
         * problem.reference_area,
         force_scale=problem.force_scale,
-        max_iterations=solver.max_iterations,
+        max_iterations=max_iterations,
         history=[],
         steps=[],
         callback=callback,
