@@ -2,6 +2,14 @@ import numpy as np
 import pytest
 
 from vares import SurfaceMesh
+from vares.materials import (
+    Fibres,
+    IncompressibleNeoHooke,
+    NeoHooke,
+    NonCrimpFabric,
+    OrthotropicStVenantKirchhoff,
+    StVenantKirchhoff,
+)
 
 
 def rotation(seed: int = 0) -> np.ndarray:
@@ -30,3 +38,14 @@ def mixed_mesh() -> SurfaceMesh:
     quads = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [4, 5, 9, 8], [5, 6, 10, 9]])
     triangles = np.array([[2, 3, 7], [2, 7, 6], [6, 7, 11], [6, 11, 10]])
     return SurfaceMesh(points, {"quad": quads, "triangle": triangles})
+
+
+#: One law of each kind, with the parameters the derivative checks use.
+LAWS = [
+    StVenantKirchhoff(E=10.0, nu=0.3),
+    NeoHooke(E=10.0, nu=0.2),
+    IncompressibleNeoHooke(mu=3.0),
+    OrthotropicStVenantKirchhoff(E1=12.0, E2=8.0, G12=1.5, nu12=0.3),
+    NonCrimpFabric(A=[-2.0, 1.0, 1.0], B=[-1.5, 1.5], C=[0.2, 0.1]),
+]
+FIBRES = Fibres.from_angles(35.0)

@@ -3,7 +3,7 @@ known in closed form."""
 
 import numpy as np
 import pytest
-from conftest import rotation
+from conftest import FIBRES, LAWS, rotation
 from scipy.optimize import brentq, fsolve
 
 import vares
@@ -12,11 +12,8 @@ from vares.geometry.elements import ELEMENTS
 from vares.geometry.examples import grid_cells
 from vares.materials import (
     Fibres,
-    IncompressibleNeoHooke,
     NeoHooke,
-    NonCrimpFabric,
     OrthotropicStVenantKirchhoff,
-    StVenantKirchhoff,
 )
 from vares.mechanics import Assembler
 from vares.mechanics.erection import Cables, ErectionProblem, membrane_block
@@ -24,14 +21,6 @@ from vares.mechanics.forward import _deformation, forward_block, reference_block
 from vares.mechanics.loads import pressure_terms
 from vares.mechanics.wrinkling import relaxed_response
 
-LAWS = [
-    StVenantKirchhoff(E=10.0, nu=0.3),
-    NeoHooke(E=10.0, nu=0.2),
-    IncompressibleNeoHooke(mu=3.0),
-    OrthotropicStVenantKirchhoff(E1=12.0, E2=8.0, G12=1.5, nu12=0.3),
-    NonCrimpFabric(A=[-2.0, 1.0, 1.0], B=[-1.5, 1.5], C=[0.2, 0.1]),
-]
-FIBRES = Fibres.from_angles(35.0)
 H = 1e-30
 TIGHT = vares.SolveOptions(tolerance=1e-14)
 

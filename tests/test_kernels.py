@@ -2,27 +2,17 @@
 
 import numpy as np
 import pytest
+from conftest import FIBRES, LAWS
 
 from vares.geometry.elements import ELEMENTS
 from vares.materials import (
     Fibres,
-    IncompressibleNeoHooke,
     NeoHooke,
-    NonCrimpFabric,
-    OrthotropicStVenantKirchhoff,
     StVenantKirchhoff,
 )
 from vares.mechanics import Assembler, Problem
 from vares.mechanics.kernels import block_energy
 
-LAWS = [
-    StVenantKirchhoff(E=10.0, nu=0.3),
-    NeoHooke(E=10.0, nu=0.2),
-    IncompressibleNeoHooke(mu=3.0),
-    OrthotropicStVenantKirchhoff(E1=12.0, E2=8.0, G12=1.5, nu12=0.3),
-    NonCrimpFabric(A=[-2.0, 1.0, 1.0], B=[-1.5, 1.5], C=[0.2, 0.1]),
-]
-FIBRES = Fibres.from_angles(35.0)
 PRESTRESS = np.array([[0.4, 0.1], [0.1, 0.25]])
 H = 1e-30
 

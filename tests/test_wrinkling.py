@@ -2,26 +2,14 @@
 
 import numpy as np
 import pytest
+from conftest import FIBRES, LAWS
 from scipy.optimize import minimize
 
 from vares.materials import (
-    Fibres,
-    IncompressibleNeoHooke,
     NeoHooke,
-    NonCrimpFabric,
     OrthotropicStVenantKirchhoff,
-    StVenantKirchhoff,
 )
 from vares.mechanics.wrinkling import SLACK, TAUT, WRINKLED, relaxed_response
-
-LAWS = [
-    StVenantKirchhoff(E=10.0, nu=0.3),
-    NeoHooke(E=10.0, nu=0.2),
-    IncompressibleNeoHooke(mu=3.0),
-    OrthotropicStVenantKirchhoff(E1=12.0, E2=8.0, G12=1.5, nu12=0.3),
-    NonCrimpFabric(A=[-2.0, 1.0, 1.0], B=[-1.5, 1.5], C=[0.2, 0.1]),
-]
-FIBRES = Fibres.from_angles(35.0)
 
 
 def stretched(l1: float, l2: float, angle: float) -> np.ndarray:

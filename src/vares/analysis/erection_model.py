@@ -16,7 +16,7 @@ import numpy as np
 
 from ..geometry.elements import ELEMENTS
 from ..geometry.mesh import SurfaceMesh
-from ..geometry.weld import Welded, boundary_loops, corner_nodes, weld
+from ..geometry.weld import Welded, corner_nodes, weld
 from ..materials import Fibres
 from ..mechanics.erection import Cables, MembraneBlock, membrane_block
 from ..mechanics.prestress import prestress_components
@@ -163,7 +163,7 @@ def _membrane(welded: Welded, patterns: list[Pattern], ids: list[np.ndarray], th
 def _supports(mesh: SurfaceMesh, options: ErectionOptions) -> tuple[np.ndarray, Cables | None]:
     """Held nodes ``(n,)`` and the edge cables (module docs)."""
     held = np.zeros(mesh.num_points, dtype=bool)
-    loops = boundary_loops(mesh)
+    loops = mesh.boundary_loops()
     if options.cable_stiffness is None:
         held[np.concatenate(loops)] = True
         return held, None

@@ -185,6 +185,8 @@ class SurfaceMesh:
             seen.add(start)
             node = following[start]
             while node != start:
+                if node in seen or node not in following:
+                    raise MeshError(f"the boundary passes twice through node {node}")
                 loop.append(node)
                 seen.add(node)
                 node = following[node]

@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 
 from .mesh import MeshError, SurfaceMesh
 
-__all__ = ["Welded", "boundary_loops", "corner_nodes", "weld"]
+__all__ = ["Welded", "corner_nodes", "weld"]
 
 
 class Welded:
@@ -88,26 +88,6 @@ def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welde
     if mesh.num_points != len(welded_points):
         raise MeshError("the welded panels left nodes without cells")
     return Welded(mesh, node_maps, cell_ranges)
-
-
-def boundary_loops(mesh: SurfaceMesh) -> list[np.ndarray]:
-    """The boundary of a surface as closed node loops, each in the direction of its cells."""
-    following = {int(a): int(b) for a, b in mesh.boundary_edges()}
-    loops, seen = [], set()
-    for start in sorted(following):
-        if start in seen:
-            continue
-        loop = [start]
-        seen.add(start)
-        node = following[start]
-        while node != start:
-            if node in seen or node not in following:
-                raise MeshError(f"the boundary passes twice through node {node}")
-            loop.append(node)
-            seen.add(node)
-            node = following[node]
-        loops.append(np.array(loop))
-    return loops
 
 
 def corner_nodes(mesh: SurfaceMesh, loop: np.ndarray, angle: float) -> np.ndarray:
