@@ -49,3 +49,19 @@ LAWS = [
     NonCrimpFabric(A=[-2.0, 1.0, 1.0], B=[-1.5, 1.5], C=[0.2, 0.1]),
 ]
 FIBRES = Fibres.from_angles(35.0)
+
+
+def run(*args):
+    """``vares ARGS…`` in this process (typer's runner): its exit code, stdout and stderr."""
+    from typer.testing import CliRunner
+
+    from vares.app.cli import app
+
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def error_line(result) -> str:
+    """The one ``vares: error:`` line a failed command printed (asserted to be one)."""
+    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
+    assert len(lines) == 1, result.stderr
+    return lines[0]

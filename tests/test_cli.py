@@ -3,23 +3,10 @@ import json
 import meshio
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from conftest import error_line, run
 
 import vares
-from vares.app.cli import app
 from vares.geometry.examples import cylinder160, cylinder_arc_length, hypar
-
-runner = CliRunner()
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def error_line(result):
-    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
-    assert len(lines) == 1, result.stderr
-    return lines[0]
 
 
 def test_example_cylinder160_writes_surface_pattern_and_summary(tmp_path):

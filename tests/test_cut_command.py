@@ -7,25 +7,13 @@ import ezdxf
 import meshio
 import numpy as np
 import pytest
+from conftest import error_line, run
 from shapely.geometry import Polygon
-from typer.testing import CliRunner
 
 import vares
-from vares.app.cli import app
 from vares.geometry.examples import saddle, tent_roof
 
-runner = CliRunner()
 FABRIC = vares.materials.fabric("pes-pvc-type-2").material()
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def error_line(result):
-    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
-    assert len(lines) == 1, result.stderr
-    return lines[0]
 
 
 @pytest.fixture(scope="module")

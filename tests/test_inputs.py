@@ -5,26 +5,13 @@ import json
 import meshio
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from conftest import error_line, run
 
 import vares
-from vares.app.cli import app
 from vares.geometry.examples import hypar
 from vares.geometry.repair import repair
 from vares.io.meshes import read_mesh_file
 from vares.io.rhino import NamedMesh, write_3dm
-
-runner = CliRunner()
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def error_line(result):
-    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
-    assert len(lines) == 1, result.stderr
-    return lines[0]
 
 
 def _obj_with_texture(path, mesh):

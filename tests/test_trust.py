@@ -4,27 +4,15 @@ import json
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from conftest import error_line, run
 
 import vares
-from vares.app.cli import app
 from vares.geometry.examples import hypar, ruffled_fan
 from vares.geometry.flatten import inverted_cells, lscm, tutte, untangle
 from vares.geometry.injectivity import pattern_overlap
 from vares.io.meshes import write_surface
 
-runner = CliRunner()
 NEO_HOOKE = vares.materials.NeoHooke(1000.0, 0.3)
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def error_line(result):
-    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
-    assert len(lines) == 1, result.stderr
-    return lines[0]
 
 
 def test_tutte_is_one_to_one_where_the_conformal_map_folds():
