@@ -174,3 +174,123 @@ def test_a_bow_tie_node_is_split_by_the_repair(tmp_path):
     assert mesh_file.repair.split_nodes == 1 and len(mesh_file.points) == 8
     pieces = mesh_file.pieces()  # now two pieces, each a surface
     assert [p.num_cells for p, _ in pieces] == [2, 2]
+
+
+def _dxf_roof(path, mesh, units: int) -> None:
+    """The roof as CAD programs export a mesh to DXF: half its triangles as 3D faces (a triangle
+    repeats its third corner), a quarter as a polyface mesh, the rest as a MESH entity."""
+    import ezdxf
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = units
+    space = doc.modelspace()
+    triangles = mesh.cells["triangle"]
+    half, three_quarters = len(triangles) // 2, 3 * len(triangles) // 4
+    for a, b, c in triangles[:half]:
+        space.add_3dface([mesh.points[a], mesh.points[b], mesh.points[c], mesh.points[c]])
+    polyface = space.add_polyface()
+    polyface.append_faces(
+        [[mesh.points[i] for i in cell] for cell in triangles[half:three_quarters]]
+    )
+    polyface.optimize()
+    with space.add_mesh().edit_data() as data:
+        data.vertices = [tuple(p) for p in mesh.points]
+        data.faces = [list(cell) for cell in triangles[three_quarters:]]
+    doc.saveas(path)
+
+
+def test_dxf_meshes_in_the_units_the_drawing_declares(tmp_path):
+    roof = vares.examples.cad_roof_mm(n=12)
+    path = tmp_path / "roof.dxf"
+    _dxf_roof(path, roof, units=4)  # millimetres
+    mesh_file = read_mesh_file(path)
+    assert mesh_file.units == "mm"
+    surface = mesh_file.surface()
+    assert surface.num_points == roof.num_points and surface.num_cells == roof.num_cells
+    assert surface.area == pytest.approx(roof.area, rel=1e-12)
+    assert mesh_file.repair.welded_nodes > 0  # the 3D faces came as a soup
+    result = run("pattern", path, "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["converged"] and summary["units"]["length"] == "mm"
+    assert not any("km" in w for w in summary["warnings"])
+    # unitless: the size warning names the fix
+    _dxf_roof(tmp_path / "unitless.dxf", roof, units=0)
+    assert read_mesh_file(tmp_path / "unitless.dxf").units is None
+    result = run("pattern", tmp_path / "unitless.dxf", "-o", tmp_path / "guess", "-q")
+    warnings = json.loads((tmp_path / "guess" / "summary.json").read_text())["warnings"]
+    assert any("12 km across in m" in w and "pass --units mm" in w for w in warnings), warnings
+    # a unit vares does not know, a drawing without faces, and garbage
+    _dxf_roof(tmp_path / "miles.dxf", roof, units=3)
+    result = run("pattern", tmp_path / "miles.dxf", "-o", tmp_path / "miles")
+    assert result.exit_code == 2 and "declares its units as Miles" in error_line(result)
+    import ezdxf
+
+    lines = ezdxf.new()
+    lines.modelspace().add_lwpolyline([(0, 0), (1, 0), (1, 1)])
+    lines.saveas(tmp_path / "outline.dxf")
+    result = run("pattern", tmp_path / "outline.dxf", "-o", tmp_path / "outline")
+    assert result.exit_code == 2 and "holds no 3D faces" in error_line(result)
+    (tmp_path / "garbage.dxf").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 8)
+    result = run("pattern", tmp_path / "garbage.dxf", "-o", tmp_path / "garbage")
+    assert result.exit_code == 2 and "cannot read" in error_line(result)
+    assert not (tmp_path / "outline").exists() and not (tmp_path / "garbage").exists()
+
+
+def _with_field_data(path, arrays: str) -> None:
+    """Put a ``FieldData`` block (as VTK writes string arrays) into a VTU file."""
+    text = path.read_text()
+    path.write_text(
+        text.replace("<UnstructuredGrid>", f"<UnstructuredGrid><FieldData>{arrays}</FieldData>", 1)
+    )
+
+
+def test_vtu_files_state_their_units_and_string_fields_are_read(tmp_path):
+    import base64
+    import struct
+
+    roof = vares.examples.cad_roof_mm(n=12)
+    _dxf_roof(tmp_path / "roof.dxf", roof, units=4)
+    result = run("pattern", tmp_path / "roof.dxf", "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.stderr
+    surface = read_mesh_file(tmp_path / "out" / "surface.vtu")
+    assert surface.units == "mm" and surface.surface().num_cells == roof.num_cells
+    assert read_mesh_file(tmp_path / "out" / "pattern.vtu").units == "mm"
+    stated = meshio.read(tmp_path / "out" / "surface.vtu").field_data  # any reader sees it
+    assert stated["metres_per_unit"].tolist() == [0.001]
+    again = run("pattern", tmp_path / "out" / "surface.vtu", "-o", tmp_path / "again", "-q")
+    assert again.exit_code == 0, again.stderr
+    summary = json.loads((tmp_path / "again" / "summary.json").read_text())
+    assert summary["units"]["length"] == "mm"
+    # string arrays as VTK writes them (ASCII and base64), which meshio alone refuses
+    plain = tmp_path / "plain.vtu"
+    cells = [("triangle", roof.cells["triangle"])]
+    meshio.write(plain, meshio.Mesh(roof.points, cells), compression=None)
+    with pytest.raises((meshio.ReadError, SystemExit)):  # meshio even exits
+        broken = tmp_path / "broken.vtu"
+        broken.write_bytes(plain.read_bytes())
+        _with_field_data(broken, '<Array type="String" Name="author" format="ascii">97 0</Array>')
+        meshio.read(broken)
+    word = b"mm\0"
+    packed = base64.b64encode(struct.pack("<I", len(word)) + word).decode()  # UInt32 header
+    for name, array in (
+        ("ascii", '<Array type="String" Name="Units" format="ascii">109 109 0</Array>'),
+        ("base64", f'<Array type="String" Name="units" format="binary">{packed}</Array>'),
+    ):
+        path = tmp_path / f"{name}.vtu"
+        path.write_bytes(plain.read_bytes())
+        note = '<Array type="String" Name="author" format="ascii">97 0</Array>'
+        _with_field_data(path, array + note)
+        mesh_file = read_mesh_file(path)
+        assert mesh_file.units == "mm", name
+        assert mesh_file.surface().num_points == roof.num_points
+    path = tmp_path / "furlong.vtu"
+    path.write_bytes(plain.read_bytes())
+    _with_field_data(path, '<Array type="String" Name="units" format="ascii">102 117 114 0</Array>')
+    result = run("pattern", path, "-o", tmp_path / "furlong")
+    assert result.exit_code == 2 and "declares its units as 'fur'" in error_line(result)
+    factor = '<DataArray type="Float64" Name="metres_per_unit" format="ascii">201.168</DataArray>'
+    path.write_bytes(plain.read_bytes())
+    _with_field_data(path, factor)
+    result = run("pattern", path, "-o", tmp_path / "furlong")
+    assert result.exit_code == 2 and "states 201.168 metres per unit" in error_line(result)

@@ -107,7 +107,9 @@ def write_cut(outcome: JobOutcome) -> None:
     write_json(directory / "cut.json", cut_summary(outcome))
     wrote("cut.json")
     cut = result.plan.cut
-    write_surface(directory / "panels.vtu", cut.mesh, fields={"panel": cut.panel_ids})
+    write_surface(
+        directory / "panels.vtu", cut.mesh, fields={"panel": cut.panel_ids}, units=outcome.units
+    )
     wrote("panels.vtu")
     _write_figure(directory / "cut_lines.png", _lines_figure(outcome))
     wrote("cut_lines.png")

@@ -54,7 +54,7 @@ def write_erection(result: ErectionResult, directory: Path, units: str) -> list[
     writers = {
         "erect.json": lambda p: write_json(p, result.to_dict(units=units)),
         "erected.vtu": lambda p: write_surface(
-            p, result.mesh, result.erected_points, fields, points
+            p, result.mesh, result.erected_points, fields, points, units=units
         ),
         "erected.obj": lambda p: write_surface(p, result.mesh, result.erected_points),
     }

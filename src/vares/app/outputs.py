@@ -127,7 +127,7 @@ def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | No
     surface); the paths go to ``panel.files``."""
     job, result = outcome.job, panel.result
     if job.input.example is not None or job.structure is not None:
-        _write(panel, "surface.obj", lambda p: write_surface(p, panel.mesh))
+        _write(panel, "surface.obj", lambda p: write_surface(p, panel.mesh, units=panel.units))
     if result.converged or result.overlap is not None:
         dxf = result.converged or job.output.allow_overlap
         _write_pattern_files(panel, job, outcome.material.stiffness_scale, marks, dxf)
@@ -168,9 +168,15 @@ def _write_pattern_files(
 ) -> None:
     result, mesh = panel.result, panel.mesh
     x = result.material_coordinates
-    _write(panel, "pattern.obj", lambda p: write_surface(p, mesh, x))
-    _write(panel, "pattern.vtu", lambda p: write_surface(p, mesh, x, result.fields))
-    _write(panel, "surface.vtu", lambda p: write_surface(p, mesh, fields=result.fields))
+    _write(panel, "pattern.obj", lambda p: write_surface(p, mesh, x, units=panel.units))
+    _write(
+        panel, "pattern.vtu", lambda p: write_surface(p, mesh, x, result.fields, units=panel.units)
+    )
+    _write(
+        panel,
+        "surface.vtu",
+        lambda p: write_surface(p, mesh, fields=result.fields, units=panel.units),
+    )
     if dxf:
         _write_dxf(panel, job, marks)
     _write_drawings(panel, job, material_scale)

@@ -173,6 +173,14 @@ class SurfaceMesh:
         table = self._edge_table()
         return table.directed[table.counts[table.edge_id] == 1]
 
+    def edges(self) -> np.ndarray:
+        """Every edge once ``(k, 2)``, oriented as in the first cell that has it."""
+        table = self._edge_table()
+        ids = table.edge_id[table.order]
+        first = np.ones(ids.size, dtype=bool)
+        first[1:] = ids[1:] != ids[:-1]
+        return table.directed[table.order[first]]
+
     def boundary_loops(self) -> list[np.ndarray]:
         """Closed node loops of the boundary, longest (most nodes) first, each in cell
         orientation (counter-clockwise for the outer loop of a positively oriented pattern)."""

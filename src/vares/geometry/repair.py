@@ -155,11 +155,11 @@ def repair(
 
 
 def _median_edge(points: np.ndarray, blocks: dict[str, np.ndarray]) -> float:
-    lengths = [
-        np.linalg.norm(points[b] - points[np.roll(b, -1, axis=1)], axis=-1).ravel()
-        for b in blocks.values()
-        if len(b)
-    ]
+    lengths = []
+    for b in blocks.values():
+        for i in range(b.shape[1] if len(b) else 0):
+            d = points[b[:, i]] - points[b[:, i - 1]]
+            lengths.append(np.sqrt(np.einsum("ij,ij->i", d, d)))
     lengths = np.concatenate(lengths) if lengths else np.zeros(0)
     lengths = lengths[lengths > 0]
     return float(np.median(lengths)) if lengths.size else 0.0
@@ -296,7 +296,9 @@ def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
         return points, blocks, 0
     table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), len(points))
     node, fan = corner_fans(len(points), table.directed, table.owner, table.edge_id, table.order)
-    pairs, label = np.unique(np.column_stack([node, fan]), axis=0, return_inverse=True)
+    fans = int(fan.max()) + 1 if fan.size else 1
+    keys, label = np.unique(node.astype(np.int64) * fans + fan, return_inverse=True)
+    pairs = np.column_stack([keys // fans, keys % fans])  # (node, fan), sorted by node
     extra = np.r_[False, pairs[1:, 0] == pairs[:-1, 0]]  # a node's second fan onward
     if not extra.any():
         return points, blocks, 0

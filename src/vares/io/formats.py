@@ -1,6 +1,7 @@
-"""Readers for the polygon formats that meshio reads too narrowly: Wavefront OBJ (faces with
-texture and normal indices ``f 1/1/1 …``, negative indices, polygons) and OFF (quads and
-polygons, ``COFF``/``NOFF`` variants, per-face colours ignored).
+"""Readers for the polygon formats that meshio reads too narrowly or not at all: Wavefront OBJ
+(faces with texture and normal indices ``f 1/1/1 …``, negative indices, polygons), OFF (quads
+and polygons, ``COFF``/``NOFF`` variants, per-face colours ignored) and DXF (3D faces, polyface
+and polygon meshes, MESH entities of the model space, with the drawing's units).
 
 Each returns a :class:`PolygonSoup`: points, triangle and quad blocks and the longer polygons,
 in the order the faces appear in the file block by block (triangles, quads, polygons).
@@ -15,7 +16,7 @@ import numpy as np
 
 from ..geometry.mesh import MeshError
 
-__all__ = ["PolygonSoup", "read_obj", "read_off"]
+__all__ = ["DXF_UNITS", "PolygonSoup", "read_dxf", "read_obj", "read_off"]
 
 
 @dataclass
@@ -148,3 +149,57 @@ def _text(path: Path) -> str:
     if b"\x00" in data[:4096]:
         raise MeshError(f"cannot read {path}: it is a binary file, not text")
     return data.decode("utf-8", errors="replace")
+
+
+#: DXF drawing units (``$INSUNITS``) and vares' names for them; 0 is "unitless".
+DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m"}
+
+
+def read_dxf(path: Path) -> tuple[PolygonSoup, str | None]:
+    """The faces of a DXF drawing's model space — ``3DFACE`` entities (a triangle when the last
+    two corners coincide), polyface and polygon meshes (``POLYLINE``) and ``MESH`` entities —
+    as one soup (coincident corners are welded by the repair), and the units the drawing
+    declares (``None`` when unitless). Faces inside blocks are not read: explode the block
+    references first."""
+    import ezdxf
+    from ezdxf.render import MeshBuilder
+
+    try:
+        doc = ezdxf.readfile(path)
+    except (OSError, ezdxf.DXFError) as exc:  # ezdxf's own errors, and unreadable bytes
+        raise MeshError(f"cannot read {path}: {exc}") from None
+    points: list = []
+    faces: list[list[int]] = []
+
+    def add(vertices, face_lists) -> None:
+        start = len(points)
+        points.extend((v.x, v.y, v.z) for v in vertices)
+        faces.extend([start + i for i in face] for face in face_lists)
+
+    for entity in doc.modelspace():
+        kind = entity.dxftype()
+        if kind == "3DFACE":
+            corners = list(entity.wcs_vertices())
+            if len(corners) == 4 and corners[3].isclose(corners[2]):
+                corners = corners[:3]
+            add(corners, [range(len(corners))])
+        elif kind == "POLYLINE" and (entity.is_poly_face_mesh or entity.is_polygon_mesh):
+            mesh = MeshBuilder.from_polyface(entity)
+            add(mesh.vertices, mesh.faces)
+        elif kind == "MESH":
+            mesh = MeshBuilder.from_mesh(entity)
+            add(mesh.vertices, mesh.faces)
+    if not faces:
+        raise MeshError(
+            f"{path} holds no 3D faces, polyface or polygon meshes, or MESH entities in its "
+            "model space: export the surface as a mesh (explode blocks that hold it)"
+        )
+    code = int(doc.header.get("$INSUNITS", 0))
+    if code and code not in DXF_UNITS:
+        from ezdxf.units import unit_name
+
+        raise MeshError(
+            f"{path} declares its units as {unit_name(code)} ($INSUNITS {code}); vares knows "
+            f"{', '.join(DXF_UNITS.values())}: change the drawing's units"
+        )
+    return _soup(points, faces, path), DXF_UNITS.get(code)

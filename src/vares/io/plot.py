@@ -10,15 +10,19 @@ from collections.abc import Sequence
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.collections import LineCollection, PolyCollection
-from matplotlib.colors import Normalize, TwoSlopeNorm
+from matplotlib.cm import ScalarMappable
+from matplotlib.collections import LineCollection
+from matplotlib.colors import ListedColormap, Normalize, TwoSlopeNorm, to_rgba
 
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres
 from ..mechanics.fields import FIELD_DESCRIPTIONS
+from .raster import CellImage, View, rasterise
 
 __all__ = [
     "FIELD_LABELS",
+    "MESH_LINES_UP_TO",
+    "View",
     "plot_convergence",
     "plot_cut_lines",
     "plot_nest",
@@ -106,13 +110,25 @@ def _colour_scale(values, field, value_range, stress_scale):
     return Normalize(low, high if high > low else low + 1e-12), "viridis"
 
 
-def _polygons(mesh: SurfaceMesh, coordinates: np.ndarray) -> np.ndarray | list[np.ndarray]:
-    """Every cell's corners, in global cell order: one ``(cells, corners, d)`` array for a mesh
-    of one cell type (matplotlib takes it whole, 20× faster than a list on 100k cells)."""
-    blocks = [coordinates[cells] for cells in mesh.cells.values()]
-    if len(blocks) == 1:
-        return blocks[0]
-    return [polygon for block in blocks for polygon in block]
+#: Meshes with at most this many cells show their mesh lines (on finer ones, a grey blur).
+MESH_LINES_UP_TO = 5_000
+_FACE = "#d9e6f2"
+_LINES = "#5b7a99"
+
+
+def _cells(ax, image: CellImage, values, norm=None, cmap=None):
+    """The cells as an image: per-cell ``values`` through ``norm`` and ``cmap``, or one colour."""
+    if values is None:
+        values, cmap, norm = np.zeros(image.index.max() + 1), ListedColormap([_FACE]), None
+    return ax.imshow(
+        image.lookup(values),
+        extent=image.extent,
+        origin="lower",
+        cmap=cmap,
+        norm=norm,
+        interpolation="nearest",
+        zorder=1,
+    )
 
 
 def plot_pattern(
@@ -134,8 +150,11 @@ def plot_pattern(
 
     ``field`` names the values (for the colour bar label and a centred colour scale); ``fibres``
     draws warp (solid) and fill (dashed) arrows; ``value_range`` fixes the colour scale;
-    ``stress_scale`` (e.g. the material's stiffness) sets the round-off level of stress fields;
-    ``marks`` ``(k, 2)`` are circled in red (where the outline crosses itself).
+    ``edges`` draws the mesh lines over a field (a plain pattern shows them up to
+    :data:`MESH_LINES_UP_TO` cells); ``stress_scale`` (e.g. the material's stiffness) sets the
+    round-off level of stress fields; ``marks`` ``(k, 2)`` are circled in red (where the
+    outline crosses itself). The cells are drawn as an image (:mod:`vares.io.raster`), the
+    outline, mesh lines and arrows as vectors.
     """
     if ax is None:
         width, height = np.ptp(coordinates, axis=0)
@@ -143,27 +162,25 @@ def plot_pattern(
         size = (6.5, 6.5 * aspect * 0.85 + 0.6) if aspect <= 1 else (6.5 / aspect + 1.5, 6.5)
         fig, ax = plt.subplots(figsize=size, layout="constrained")
     fig = ax.figure
-    polygons = _polygons(mesh, coordinates)
+    image = rasterise(mesh.cells, coordinates)
     if values is None:
-        collection = PolyCollection(
-            polygons, facecolors="#d9e6f2", edgecolors="#5b7a99", linewidths=0.2, rasterized=True
-        )
-        ax.add_collection(collection)
+        _cells(ax, image, None)
+        if mesh.num_cells <= MESH_LINES_UP_TO:
+            lines = LineCollection(
+                coordinates[mesh.edges()], colors=_LINES, linewidths=0.2, rasterized=True
+            )
+            ax.add_collection(lines)
     else:
         values = np.asarray(values, dtype=float)
         norm, cmap = _colour_scale(values, field, value_range, stress_scale)
-        collection = PolyCollection(
-            polygons,
-            array=values,
-            cmap=cmap,
-            norm=norm,
-            edgecolors="k" if edges else "face",
-            linewidths=0.1 if edges else 0.3,
-            rasterized=True,  # vector drawings keep the outline and arrows, cells as an image
-        )
-        ax.add_collection(collection)
+        shown = _cells(ax, image, values, norm, cmap)
+        if edges:
+            lines = LineCollection(
+                coordinates[mesh.edges()], colors="k", linewidths=0.1, rasterized=True
+            )
+            ax.add_collection(lines)
         label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
-        fig.colorbar(collection, ax=ax, label=label, shrink=0.85)
+        fig.colorbar(shown, ax=ax, label=label, shrink=0.85)
     boundary = mesh.boundary_edges()
     ax.add_collection(LineCollection(coordinates[boundary], colors="k", linewidths=0.6))
     if marks is not None and len(marks):
@@ -193,6 +210,68 @@ def save_pattern_figure(path, *args, dpi: int = 150, **kwargs) -> None:
     plt.close(fig)
 
 
+class _SurfaceView:
+    """The surface seen from a :class:`View`: its cells rasterised with a depth buffer and
+    shaded by how squarely they face the viewer, lines drawn where the view sees them, and a
+    small triad of the model axes."""
+
+    def __init__(self, mesh: SurfaceMesh, ax, view: View):
+        self.mesh, self.ax, self.view = mesh, ax, view
+        self.screen, self.depth = view.project(mesh.points)
+        self.image = rasterise(mesh.cells, self.screen, self.depth)
+        normals = _cell_normals(mesh)
+        self.shade = 0.55 + 0.45 * np.abs(normals @ view.axes()[2])
+
+    def cells(self, colours: np.ndarray) -> None:
+        """Per-cell RGBA colours ``(cells, 4)``, shaded."""
+        shaded = colours.copy()
+        shaded[:, :3] *= self.shade[:, None]
+        rgba = self.image.lookup(shaded).filled(0.0)
+        self.ax.imshow(rgba, extent=self.image.extent, origin="lower", interpolation="nearest")
+
+    def lines(self, segments: np.ndarray, **style) -> None:
+        """Node pairs ``(k, 2)`` drawn where they are seen (tested at their ends and middle)."""
+        if not len(segments):
+            return
+        seen = np.ones(len(segments), dtype=bool)
+        a, b = segments[:, 0], segments[:, 1]
+        for t in (0.0, 0.5, 1.0):
+            points = (1 - t) * self.screen[a] + t * self.screen[b]
+            depth = (1 - t) * self.depth[a] + t * self.depth[b]
+            seen &= self.image.seen(points, depth)
+        self.ax.add_collection(LineCollection(self.screen[segments[seen]], **style))
+
+    def finish(self, title: str | None) -> None:
+        ax = self.ax
+        ax.set_aspect("equal")
+        ax.set_axis_off()
+        right, up, _ = self.view.axes()
+        x0, x1, y0, y1 = self.image.extent
+        size = 0.07 * max(x1 - x0, y1 - y0)
+        origin = np.array([x0 - 1.5 * size, y0])
+        for k, name in enumerate("xyz"):
+            tip = origin + size * np.array([right[k], up[k]])
+            ax.plot(*np.column_stack([origin, tip]), color="k", lw=1)  # also widens the limits
+            ax.plot(*tip, marker="o", ms=2, color="k")
+            label = origin + 1.3 * size * np.array([right[k], up[k]])
+            ax.text(*label, name, fontsize=8, ha="center", va="center")
+        if title:
+            ax.set_title(title)
+
+
+def _cell_normals(mesh: SurfaceMesh) -> np.ndarray:
+    """Unit normal of every cell (global order), from its diagonals (triangles: two edges)."""
+    normals = []
+    for cells in mesh.cells.values():
+        p = mesh.points[cells]
+        if cells.shape[1] == 3:
+            n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        else:
+            n = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
+        normals.append(n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300))
+    return np.vstack(normals)
+
+
 def plot_surface(
     mesh: SurfaceMesh,
     values: np.ndarray | None = None,
@@ -202,45 +281,27 @@ def plot_surface(
     title: str | None = None,
     stress_unit: str = "stress",
     stress_scale: float | None = None,
+    view: View | None = None,
 ) -> plt.Figure:
-    """3D view of the surface, optionally coloured by per-cell ``values``."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
+    """A view of the surface (``view``: from 30° above, azimuth −60°, as matplotlib's 3D axes),
+    optionally coloured by per-cell ``values``; hidden cells stay hidden (depth buffer)."""
     if ax is None:
-        fig = plt.figure(figsize=(7, 5.5), layout="constrained")
-        ax = fig.add_subplot(projection="3d")
+        fig, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
     fig = ax.figure
-    polygons = _polygons(mesh, mesh.points)
+    seen = _SurfaceView(mesh, ax, view or View())
     if values is None:
-        collection = Poly3DCollection(
-            polygons, facecolors="#d9e6f2", edgecolors="#5b7a99", linewidths=0.1
-        )
+        seen.cells(np.tile(to_rgba(_FACE), (mesh.num_cells, 1)))
     else:
         values = np.asarray(values, dtype=float)
         norm, cmap = _colour_scale(values, field, None, stress_scale)
-        collection = Poly3DCollection(
-            polygons,
-            array=values,
-            cmap=cmap,
-            norm=norm,
-            edgecolors=(0.25, 0.25, 0.25, 0.25),  # the shape shows whatever the colours
-            linewidths=0.15,
-            rasterized=True,
-        )
+        mappable = ScalarMappable(norm=norm, cmap=cmap)
+        seen.cells(mappable.to_rgba(values))
         label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
-        fig.colorbar(collection, ax=ax, label=label, shrink=0.7)
-    ax.add_collection3d(collection)
-    low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
-    centre, half = 0.5 * (low + high), 0.5 * float(np.max(high - low))
-    ax.set_xlim(centre[0] - half, centre[0] + half)
-    ax.set_ylim(centre[1] - half, centre[1] + half)
-    ax.set_zlim(centre[2] - half, centre[2] + half)
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_zlabel("z")
-    if title:
-        ax.set_title(title)
+        fig.colorbar(mappable, ax=ax, label=label, shrink=0.7)
+    if mesh.num_cells <= MESH_LINES_UP_TO:
+        seen.lines(mesh.edges(), colors=(0.25, 0.25, 0.25, 0.35), linewidths=0.15, rasterized=True)
+    seen.lines(mesh.boundary_edges(), colors="k", linewidths=0.6)
+    seen.finish(title)
     return fig
 
 
@@ -280,30 +341,16 @@ def plot_cut_lines(
     *,
     title: str | None = None,
 ) -> plt.Figure:
-    """3D view of a cut surface: every strip in its own colour, the cutting lines (node chains)
-    drawn over it."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-    fig = plt.figure(figsize=(8, 6), layout="constrained")
-    ax = fig.add_subplot(projection="3d")
-    cells = np.vstack(list(mesh.cells.values()))
-    colours = plt.get_cmap("tab20")(np.mod(panel_ids, 20))
-    ax.add_collection3d(
-        Poly3DCollection(mesh.points[cells], facecolors=colours, edgecolors="none", alpha=0.9)
-    )
-    for chain in lines:
-        path = mesh.points[chain]
-        ax.plot(path[:, 0], path[:, 1], path[:, 2], color="black", linewidth=1.2)
-    low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
-    for axis, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), low, high, strict=True):
-        axis(a, b)
-    ax.set_box_aspect(np.maximum(high - low, 1e-3 * np.max(high - low)))  # true proportions
-    ax.view_init(elev=30, azim=-60)
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_zlabel("z")
-    if title:
-        ax.set_title(title)
+    """A view of a cut surface: every strip in its own colour, the cutting lines (node chains)
+    drawn over it where they are seen."""
+    fig, ax = plt.subplots(figsize=(8, 6), layout="constrained")
+    seen = _SurfaceView(mesh, ax, View())
+    seen.cells(plt.get_cmap("tab20")(np.mod(panel_ids, 20)))
+    segments = [np.column_stack([chain[:-1], chain[1:]]) for chain in lines if len(chain) > 1]
+    if segments:
+        seen.lines(np.vstack(segments), colors="k", linewidths=1.2)
+    seen.lines(mesh.boundary_edges(), colors="k", linewidths=0.6)
+    seen.finish(title)
     return fig
 
 
