@@ -116,6 +116,17 @@ _FACE = "#d9e6f2"
 _LINES = "#5b7a99"
 
 
+def _figure(size: tuple[float, float]):
+    """A figure with one axes and fixed margins (room for a title, tick labels and a colour
+    bar): a constrained layout took 0.1 s of a 0.25 s picture, a report has nine."""
+    fig, ax = plt.subplots(figsize=size)
+    width, height = size
+    fig.subplots_adjust(
+        left=0.7 / width, right=1 - 0.25 / width, bottom=0.45 / height, top=1 - 0.4 / height
+    )
+    return fig, ax
+
+
 def _cells(ax, image: CellImage, values, norm=None, cmap=None):
     """The cells as an image: per-cell ``values`` through ``norm`` and ``cmap``, or one colour."""
     if values is None:
@@ -160,7 +171,7 @@ def plot_pattern(
         width, height = np.ptp(coordinates, axis=0)
         aspect = float(np.clip(height / width, 0.3, 3.0)) if width > 0 else 1.0
         size = (6.5, 6.5 * aspect * 0.85 + 0.6) if aspect <= 1 else (6.5 / aspect + 1.5, 6.5)
-        fig, ax = plt.subplots(figsize=size, layout="constrained")
+        fig, ax = _figure(size)
     fig = ax.figure
     image = rasterise(mesh.cells, coordinates)
     if values is None:
@@ -286,7 +297,7 @@ def plot_surface(
     """A view of the surface (``view``: from 30° above, azimuth −60°, as matplotlib's 3D axes),
     optionally coloured by per-cell ``values``; hidden cells stay hidden (depth buffer)."""
     if ax is None:
-        fig, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
+        fig, ax = _figure((7, 5.5))
     fig = ax.figure
     seen = _SurfaceView(mesh, ax, view or View())
     if values is None:
@@ -343,7 +354,7 @@ def plot_cut_lines(
 ) -> plt.Figure:
     """A view of a cut surface: every strip in its own colour, the cutting lines (node chains)
     drawn over it where they are seen."""
-    fig, ax = plt.subplots(figsize=(8, 6), layout="constrained")
+    fig, ax = _figure((8, 6))
     seen = _SurfaceView(mesh, ax, View())
     seen.cells(plt.get_cmap("tab20")(np.mod(panel_ids, 20)))
     segments = [np.column_stack([chain[:-1], chain[1:]]) for chain in lines if len(chain) > 1]
