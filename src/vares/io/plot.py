@@ -270,6 +270,14 @@ class _SurfaceView:
             ax.set_title(title)
 
 
+def _view_size(mesh: SurfaceMesh, view: View, width: float, drawing: float) -> tuple:
+    """A figure ``width`` inches wide whose height fits the view of the surface drawn
+    ``drawing`` inches wide (between 0.35 and 1.5 times as high as wide)."""
+    across, high = np.ptp(view.project(mesh.points)[0], axis=0)
+    aspect = float(np.clip(high / across, 0.35, 1.5)) if across > 0 else 1.0
+    return width, 0.9 + drawing * aspect
+
+
 def _cell_normals(mesh: SurfaceMesh) -> np.ndarray:
     """Unit normal of every cell (global order), from its diagonals (triangles: two edges)."""
     normals = []
@@ -296,10 +304,11 @@ def plot_surface(
 ) -> plt.Figure:
     """A view of the surface (``view``: from 30° above, azimuth −60°, as matplotlib's 3D axes),
     optionally coloured by per-cell ``values``; hidden cells stay hidden (depth buffer)."""
+    view = view or View()
     if ax is None:
-        fig, ax = _figure((7, 5.5))
+        fig, ax = _figure(_view_size(mesh, view, 7.0, 5.2))
     fig = ax.figure
-    seen = _SurfaceView(mesh, ax, view or View())
+    seen = _SurfaceView(mesh, ax, view)
     if values is None:
         seen.cells(np.tile(to_rgba(_FACE), (mesh.num_cells, 1)))
     else:
@@ -354,7 +363,7 @@ def plot_cut_lines(
 ) -> plt.Figure:
     """A view of a cut surface: every strip in its own colour, the cutting lines (node chains)
     drawn over it where they are seen."""
-    fig, ax = _figure((8, 6))
+    fig, ax = _figure(_view_size(mesh, View(), 8.0, 7.0))
     seen = _SurfaceView(mesh, ax, View())
     seen.cells(plt.get_cmap("tab20")(np.mod(panel_ids, 20)))
     segments = [np.column_stack([chain[:-1], chain[1:]]) for chain in lines if len(chain) > 1]
