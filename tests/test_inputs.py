@@ -294,3 +294,32 @@ def test_vtu_files_state_their_units_and_string_fields_are_read(tmp_path):
     _with_field_data(path, factor)
     result = run("pattern", path, "-o", tmp_path / "furlong")
     assert result.exit_code == 2 and "states 201.168 metres per unit" in error_line(result)
+
+
+def test_dxf_layers_name_the_panels_of_a_structure(tmp_path):
+    """Three strips of a roof on three layers of one DXF, joined at their seams (one piece):
+    ``--panel-field layer`` makes them the panels, named by their layers."""
+    import ezdxf
+
+    roof = hypar(size=6.0, n=12)
+    cells = roof.cells["triangle"]
+    strip = np.minimum(((roof.points[cells].mean(axis=1)[:, 0] + 3.0) // 2.0).astype(int), 2)
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 6
+    for index, layer in enumerate(("EAST", "MIDDLE", "WEST")):
+        for a, b, c in cells[strip == index]:
+            doc.modelspace().add_3dface(
+                [roof.points[a], roof.points[b], roof.points[c], roof.points[c]],
+                dxfattribs={"layer": layer},
+            )
+    path = tmp_path / "strips.dxf"
+    doc.saveas(path)
+    mesh_file = read_mesh_file(path)
+    assert mesh_file.cell_names["layer"] == {0: "EAST", 1: "MIDDLE", 2: "WEST"}
+    assert np.bincount(mesh_file.cell_data["layer"]).tolist() == np.bincount(strip).tolist()
+    result = run("panels", path, "--panel-field", "layer", "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.stderr
+    structure = json.loads((tmp_path / "out" / "structure.json").read_text())
+    assert structure["converged"]
+    assert sorted(p["name"] for p in structure["panels"]) == ["EAST", "MIDDLE", "WEST"]
+    assert all((tmp_path / "out" / name / "pattern.dxf").is_file() for name in ("EAST", "WEST"))

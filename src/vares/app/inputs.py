@@ -149,7 +149,8 @@ def _split(job: Job, mesh_file: MeshFile) -> list[Panel]:
     """Panels by the panel field of the cell data or, without one, the mesh's separate pieces."""
     key = job.input.panel_field
     if key in mesh_file.cell_data:
-        return split_panels(mesh_file.surface(), mesh_file.cell_data[key])
+        names = mesh_file.cell_names.get(key)  # a DXF's layer names
+        return split_panels(mesh_file.surface(), mesh_file.cell_data[key], names)
     pieces = mesh_file.pieces()
     if len(pieces) < 2:
         raise MeshError(

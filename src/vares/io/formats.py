@@ -155,12 +155,13 @@ def _text(path: Path) -> str:
 DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m"}
 
 
-def read_dxf(path: Path) -> tuple[PolygonSoup, str | None]:
+def read_dxf(path: Path) -> tuple[PolygonSoup, str | None, np.ndarray, list[str]]:
     """The faces of a DXF drawing's model space — ``3DFACE`` entities (a triangle when the last
     two corners coincide), polyface and polygon meshes (``POLYLINE``) and ``MESH`` entities —
-    as one soup (coincident corners are welded by the repair), and the units the drawing
-    declares (``None`` when unitless). Faces inside blocks are not read: explode the block
-    references first."""
+    as one soup (coincident corners are welded by the repair), the units the drawing declares
+    (``None`` when unitless), the layer of every face (an index into the layer names; faces in
+    the soup's order: triangles, quads, polygons) and the layer names. Faces inside blocks are
+    not read: explode the block references first."""
     import ezdxf
     from ezdxf.render import MeshBuilder
 
@@ -170,11 +171,15 @@ def read_dxf(path: Path) -> tuple[PolygonSoup, str | None]:
         raise MeshError(f"cannot read {path}: {exc}") from None
     points: list = []
     faces: list[list[int]] = []
+    layer_of_face: list[int] = []
+    layers: dict[str, int] = {}
 
-    def add(vertices, face_lists) -> None:
+    def add(vertices, face_lists, layer: str) -> None:
         start = len(points)
         points.extend((v.x, v.y, v.z) for v in vertices)
-        faces.extend([start + i for i in face] for face in face_lists)
+        face_lists = [[start + i for i in face] for face in face_lists]
+        faces.extend(face_lists)
+        layer_of_face.extend([layers.setdefault(layer, len(layers))] * len(face_lists))
 
     for entity in doc.modelspace():
         kind = entity.dxftype()
@@ -182,13 +187,13 @@ def read_dxf(path: Path) -> tuple[PolygonSoup, str | None]:
             corners = list(entity.wcs_vertices())
             if len(corners) == 4 and corners[3].isclose(corners[2]):
                 corners = corners[:3]
-            add(corners, [range(len(corners))])
+            add(corners, [range(len(corners))], entity.dxf.layer)
         elif kind == "POLYLINE" and (entity.is_poly_face_mesh or entity.is_polygon_mesh):
             mesh = MeshBuilder.from_polyface(entity)
-            add(mesh.vertices, mesh.faces)
+            add(mesh.vertices, mesh.faces, entity.dxf.layer)
         elif kind == "MESH":
             mesh = MeshBuilder.from_mesh(entity)
-            add(mesh.vertices, mesh.faces)
+            add(mesh.vertices, mesh.faces, entity.dxf.layer)
     if not faces:
         raise MeshError(
             f"{path} holds no 3D faces, polyface or polygon meshes, or MESH entities in its "
@@ -202,4 +207,8 @@ def read_dxf(path: Path) -> tuple[PolygonSoup, str | None]:
             f"{path} declares its units as {unit_name(code)} ($INSUNITS {code}); vares knows "
             f"{', '.join(DXF_UNITS.values())}: change the drawing's units"
         )
-    return _soup(points, faces, path), DXF_UNITS.get(code)
+    sizes = np.array([len(face) for face in faces])
+    kept = np.flatnonzero(sizes >= 3)  # the soup's order: triangles, quads, polygons
+    order = kept[np.argsort(np.minimum(sizes[kept], 5), kind="stable")]
+    layer = np.array(layer_of_face, dtype=np.int64)[order]
+    return _soup(points, faces, path), DXF_UNITS.get(code), layer, list(layers)

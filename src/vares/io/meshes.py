@@ -42,7 +42,8 @@ class RawSurface:
     """A file's points and faces as stored (no repair), its cell data (by face, in the order
     triangles, quads, polygons), the length units it declares, and the resolution of its
     coordinates (the spacing of single precision numbers at its largest coordinate; 0 when
-    stored in double precision or as text)."""
+    stored in double precision or as text); ``cell_names`` names the integer values of a cell
+    data field where the file gives names (a DXF's layers)."""
 
     points: np.ndarray
     cells: dict[str, np.ndarray]
@@ -50,6 +51,7 @@ class RawSurface:
     cell_data: dict[str, np.ndarray] = field(default_factory=dict)
     units: str | None = None
     resolution: float = 0.0
+    cell_names: dict[str, dict[int, str]] = field(default_factory=dict)
 
 
 @dataclass
@@ -64,6 +66,7 @@ class MeshFile:
     units: str | None
     resolution: float
     repair: RepairReport
+    cell_names: dict[str, dict[int, str]] = field(default_factory=dict)
 
     def surface(self) -> SurfaceMesh:
         """The surface, validated (a :class:`MeshError` names what is wrong and where)."""
@@ -167,7 +170,14 @@ def read_mesh_file(path: str | Path, *, repair: bool = True) -> MeshFile:
         )
     cell_data = {name: np.asarray(values)[fixed.cell_map] for name, values in raw.cell_data.items()}
     return MeshFile(
-        path, fixed.points, fixed.cells, cell_data, raw.units, raw.resolution, fixed.report
+        path,
+        fixed.points,
+        fixed.cells,
+        cell_data,
+        raw.units,
+        raw.resolution,
+        fixed.report,
+        raw.cell_names,
     )
 
 
@@ -182,8 +192,15 @@ def read_raw(path: Path) -> RawSurface:
     if suffix == ".3dm":
         return _read_3dm(path)
     if suffix == ".dxf":
-        soup, units = read_dxf(path)
-        return RawSurface(soup.points, soup.cells, soup.polygons, units=units)
+        soup, units, layer, names = read_dxf(path)
+        return RawSurface(
+            soup.points,
+            soup.cells,
+            soup.polygons,
+            {"layer": layer},
+            units=units,
+            cell_names={"layer": dict(enumerate(names))},
+        )
     if suffix in (".obj", ".off"):
         soup = read_obj(path) if suffix == ".obj" else read_off(path)
         return RawSurface(soup.points, soup.cells, soup.polygons)
