@@ -66,3 +66,14 @@ def test_surface_view_draws_the_cells_it_sees():
     plt.close(fig)
     image = rasterise(mesh.cells, *View(elevation=89.0).project(mesh.points))
     assert set(np.unique(image.index[image.index >= 0])) == set(range(mesh.num_cells))
+
+
+def test_a_drawing_no_pixel_centre_falls_in_is_empty_not_an_error():
+    from vares.io.plot import _cells
+
+    sliver = np.array([[0.0, 0.0], [1000.0, 0.0], [500.0, 1e-4]])
+    image = rasterise({"triangle": np.array([[0, 1, 2]])}, sliver)
+    assert np.all(image.index == -1)
+    fig, ax = plt.subplots()
+    assert _cells(ax, image, None).get_array().mask.all()
+    plt.close(fig)

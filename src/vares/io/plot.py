@@ -130,7 +130,11 @@ def _figure(size: tuple[float, float]):
 def _cells(ax, image: CellImage, values, norm=None, cmap=None):
     """The cells as an image: per-cell ``values`` through ``norm`` and ``cmap``, or one colour."""
     if values is None:
-        values, cmap, norm = np.zeros(image.index.max() + 1), ListedColormap([_FACE]), None
+        values, cmap, norm = (
+            np.zeros(max(int(image.index.max()) + 1, 1)),
+            ListedColormap([_FACE]),
+            None,
+        )
     return ax.imshow(
         image.lookup(values),
         extent=image.extent,
