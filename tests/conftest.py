@@ -57,7 +57,7 @@ def run(*args):
 
     from vares.app.cli import app
 
-    return CliRunner().invoke(app, [str(a) for a in args])
+    return CliRunner().invoke(app, [str(a) for a in args], env={"COLUMNS": "200"})
 
 
 def error_line(result) -> str:

@@ -5,13 +5,10 @@ import json
 import meshio
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from conftest import run
 
 from vares.app.batch import is_complete, run_batch
-from vares.app.cli import app
 from vares.app.job import JobError, load_job
-
-runner = CliRunner()
 
 
 def write_jobs(folder, count=8):
@@ -65,12 +62,12 @@ def test_jobs_sharing_an_output_folder_are_refused_before_any_work(tmp_path):
 
 def test_batch_command(tmp_path):
     paths = write_jobs(tmp_path, 2)
-    result = runner.invoke(app, ["batch", *map(str, paths), "--workers", "1"])
+    result = run("batch", *paths, "--workers", 1)
     assert result.exit_code == 0, result.stderr
     assert "2 done" in result.stderr
     summary = json.loads((tmp_path / "out1" / "summary.json").read_text())
     assert summary["converged"] and summary["job_digest"]
-    result = runner.invoke(app, ["batch", str(paths[0]), str(tmp_path / "nope.toml")])
+    result = run("batch", paths[0], tmp_path / "nope.toml")
     assert result.exit_code == 2 and "no such file" in result.stderr
 
 

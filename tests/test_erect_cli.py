@@ -7,14 +7,12 @@ import json
 import meshio
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from conftest import error_line, run
 
 import vares
 from vares.analysis import ErectionOptions
-from vares.app.cli import app
 from vares.app.job import SECTIONS, load_job
 
-runner = CliRunner()
 FILES = {
     "erect.json",
     "erected.vtu",
@@ -24,16 +22,6 @@ FILES = {
     "fill_stress.png",
     "state.png",
 }
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args], env={"COLUMNS": "200"})
-
-
-def error_line(result):
-    lines = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
-    assert len(lines) == 1, result.stderr
-    return lines[0]
 
 
 def test_pattern_then_erect_the_directory_matches_erect_in_the_same_run(tmp_path):

@@ -9,20 +9,13 @@ import ezdxf
 import meshio
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from conftest import run
 
 import vares
-from vares.app.cli import app
 from vares.app.job import JobError, load_job
 from vares.geometry.examples import grid_cells
 from vares.io.dxf import CutPiece, write_dxf
 from vares.io.rhino import NamedMesh, read_3dm, write_3dm
-
-runner = CliRunner()
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
 
 
 def rectangle(width=2.0, height=1.0, nx=5, ny=3):

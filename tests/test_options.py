@@ -8,7 +8,7 @@ import meshio
 import numpy as np
 import pytest
 import typer
-from typer.testing import CliRunner
+from conftest import run
 
 import vares
 from vares.app.cli import app
@@ -18,8 +18,6 @@ from vares.geometry.examples import hypar
 from vares.options import OptionsError
 from vares.solver import SolveOptions
 from vares.structures import StructureOptions
-
-runner = CliRunner()
 
 #: A run with every solver option away from its default (and an anisotropic law, so that the
 #: fibre options matter).
@@ -70,22 +68,19 @@ def test_the_same_run_from_the_api_a_job_file_and_the_command_line(tmp_path):
     saved = tmp_path / "saved.toml"
     flags = [f"--{k.replace('_', '-')}={v}" for k, v in SETTINGS.items()]
     flags += [f"--{k}={v}" for k, v in LAW.items()]
-    result = runner.invoke(
-        app,
-        [
-            "pattern",
-            str(path),
-            "-o",
-            str(tmp_path / "cli-out"),
-            "--material",
-            "orthotropic",
-            "--thickness",
-            "0.8",
-            *flags,
-            "--save-job",
-            str(saved),
-            "-q",
-        ],
+    result = run(
+        "pattern",
+        path,
+        "-o",
+        tmp_path / "cli-out",
+        "--material",
+        "orthotropic",
+        "--thickness",
+        0.8,
+        *flags,
+        "--save-job",
+        saved,
+        "-q",
     )
     assert result.exit_code == 0, result.stderr
     assert load_job(saved).solve == api.options
@@ -112,7 +107,7 @@ def test_every_option_is_reachable_from_all_three_with_one_default():
             assert structure[name].default == default, name
             if cls is SolveOptions:
                 assert solve[name].default == default, name
-    help_text = runner.invoke(app, ["pattern", "--help"], env={"COLUMNS": "200"}).stdout
+    help_text = run("pattern", "--help").stdout
     assert "[default: 1e-10]" in help_text and "[default: 50]" in help_text
 
 
@@ -168,9 +163,9 @@ def test_api_settings_are_checked_alike():
 
 
 def test_command_line_values_are_checked_by_the_same_declarations(tmp_path):
-    result = runner.invoke(app, ["example", "hypar", "-o", str(tmp_path), "--tolerance", "-1"])
+    result = run("example", "hypar", "-o", tmp_path, "--tolerance", -1)
     assert result.exit_code == 2
     assert "vares: error: --tolerance must be > 0; got -1.0" in result.stderr
-    result = runner.invoke(app, ["example", "hypar", "-o", str(tmp_path), "--damping", "0"])
+    result = run("example", "hypar", "-o", tmp_path, "--damping", 0)
     assert result.exit_code == 2 and "--damping must be > 0" in result.stderr
     assert not any(tmp_path.iterdir())

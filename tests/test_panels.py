@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from conftest import run
 
 import vares
 from vares.geometry.examples import grid_cells, hypar_strips
@@ -156,12 +157,9 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
     import json
 
     import meshio
-    from typer.testing import CliRunner
 
-    from vares.app.cli import app
     from vares.io.rhino import NamedMesh, write_3dm
 
-    runner = CliRunner()
     mesh, ids = hypar_strips(strips=3, cells_per_strip=3, n=9)
     source = tmp_path / "sail.vtu"
     meshio.write(
@@ -171,27 +169,24 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
         ),
     )
     out = tmp_path / "cells"
-    result = runner.invoke(
-        app,
-        [
-            "panels",
-            str(source),
-            "--panel-field",
-            "strip",
-            "-o",
-            str(out),
-            "--fabric",
-            "pes-pvc-type-2",
-            "--prestress",
-            "2,1.5",
-            "--warp-direction",
-            "0,1,0",
-            "--mark-spacing",
-            "2000",
-            "--roll-width",
-            "3.5",
-            "-q",
-        ],
+    result = run(
+        "panels",
+        source,
+        "--panel-field",
+        "strip",
+        "-o",
+        out,
+        "--fabric",
+        "pes-pvc-type-2",
+        "--prestress",
+        "2,1.5",
+        "--warp-direction",
+        "0,1,0",
+        "--mark-spacing",
+        2000,
+        "--roll-width",
+        3.5,
+        "-q",
     )
     assert result.exit_code == 0, result.stderr
     data = json.loads((out / "structure.json").read_text())
@@ -207,10 +202,7 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
     # the same panels as a Rhino file and as separate files
     panels = split_panels(mesh, ids, {0: "a", 1: "b", 2: "c"})
     write_3dm(tmp_path / "sail.3dm", [NamedMesh(p.name, "membrane", p.mesh) for p in panels])
-    result = runner.invoke(
-        app,
-        ["panels", str(tmp_path / "sail.3dm"), "-o", str(tmp_path / "rhino"), "--no-match", "-q"],
-    )
+    result = run("panels", tmp_path / "sail.3dm", "-o", tmp_path / "rhino", "--no-match", "-q")
     assert result.exit_code == 0, result.stderr
     data = json.loads((tmp_path / "rhino" / "structure.json").read_text())
     assert [p["name"] for p in data["panels"]] == ["a", "b", "c"] and not data["matched"]
@@ -219,26 +211,16 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
     for p in panels:
         files.append(tmp_path / f"{p.name}.obj")
         meshio.write(files[-1], meshio.Mesh(p.mesh.points, list(p.mesh.cells.items())))
-    result = runner.invoke(app, ["panels", *map(str, files), "-o", str(tmp_path / "files"), "-q"])
+    result = run("panels", *files, "-o", tmp_path / "files", "-q")
     assert result.exit_code == 0, result.stderr
-    result = runner.invoke(app, ["panels", str(files[0]), "-o", str(tmp_path / "one")])
+    result = run("panels", files[0], "-o", tmp_path / "one")
     assert result.exit_code == 2 and "panel ids" in result.stderr
-
-
-def _cli(*args):
-    from typer.testing import CliRunner
-
-    from vares.app.cli import app
-
-    return CliRunner().invoke(app, [str(a) for a in args])
 
 
 def test_the_iteration_limit_holds_for_every_panel_solve_and_the_matching(tmp_path):
     import json
 
-    result = _cli(
-        "panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 2, "-q"
-    )
+    result = run("panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 2, "-q")
     assert result.exit_code == 0, result.stderr
     data = json.loads((tmp_path / "structure.json").read_text())
     assert data["converged"] and 1 <= data["coupled_iterations"] <= 2
@@ -264,7 +246,7 @@ def test_a_structure_whose_matching_fails_says_so_everywhere(tmp_path, monkeypat
     assert structure.reason == "seam matching: iteration limit (3) reached"
     assert structure.iterations == 3
     assert all(not r.converged and r.reason == structure.reason for r in structure.results)
-    result = _cli("panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 3)
+    result = run("panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 3)
     assert result.exit_code == 1
     error = [line for line in result.stderr.splitlines() if line.startswith("vares: error:")]
     assert error == [
@@ -316,11 +298,11 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
     cells = [("triangle", mesh.cells["triangle"])]
     meshio.write(source, meshio.Mesh(mesh.points, cells, cell_data={"panel": [ids]}))
     out, saved = tmp_path / "out", tmp_path / "jobs" / "sail.toml"
-    result = _cli(
+    result = run(
         "panels", source, "-o", out, "--report", "--plot", "det_F", "--save-job", saved, "-q"
     )
     assert result.exit_code == 0, result.stderr
-    single = _cli("pattern", source, "-o", tmp_path / "single", "--plot", "det_F", "-q")
+    single = run("pattern", source, "-o", tmp_path / "single", "--plot", "det_F", "-q")
     assert single.exit_code == 0, single.stderr
     expected = {p.name for p in (tmp_path / "single").iterdir()} | {"surface.obj", "report.html"}
     expected -= {".vares-run.json", "job.toml"}  # a run's manifest and job: in its folder only
@@ -343,10 +325,10 @@ def test_panels_write_what_pattern_writes_per_panel_and_run_again_from_the_saved
         'mesh = "../sail.vtu"' in text and 'directory = "../out"' in text and "[structure]" in text
     )
     moved = tmp_path / "moved"
-    result = _cli("run", saved, "-o", moved, "-q")
+    result = run("run", saved, "-o", moved, "-q")
     assert result.exit_code == 0, result.stderr
     first = json.loads((out / "structure.json").read_text())
     again = json.loads((moved / "structure.json").read_text())
     assert again["energy"] == first["energy"] and again["converged"]
-    result = _cli("run", saved, "-q")  # the job's own folder exists: nothing is overwritten
+    result = run("run", saved, "-q")  # the job's own folder exists: nothing is overwritten
     assert result.exit_code == 2 and "output exists" in result.stderr
