@@ -19,6 +19,22 @@ def test_mixed_mesh_areas_and_read_only(mixed_mesh):
         mixed_mesh.cells["quad"][0, 0] = 3
 
 
+def test_area_vectors_are_areas_along_the_normals(mixed_mesh):
+    """A flat square tilted about x by 30°: every cell's vector is its area along the tilted
+    normal; on a mixed mesh of triangles and flat quads the vectors' lengths are the cells'
+    areas."""
+    tilt = np.radians(30.0)
+    rotation = np.array(
+        [[1, 0, 0], [0, np.cos(tilt), -np.sin(tilt)], [0, np.sin(tilt), np.cos(tilt)]]
+    )
+    grid = hypar(size=2.0, rise=0.0, n=4, cell_type="quad")
+    tilted = grid.transformed(grid.points @ rotation.T)
+    vectors = tilted.area_vectors()
+    np.testing.assert_allclose(vectors, np.outer(tilted.cell_areas(), rotation[:, 2]), atol=1e-14)
+    lengths = np.linalg.norm(mixed_mesh.area_vectors(), axis=1)
+    np.testing.assert_allclose(lengths, mixed_mesh.cell_areas(), rtol=1e-12)
+
+
 def test_flat_area_of_a_grid():
     mesh = SurfaceMesh(
         np.column_stack(

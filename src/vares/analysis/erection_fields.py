@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.elements import ELEMENTS, determinant
+from ..geometry.elements import determinant
 from ..geometry.mesh import SurfaceMesh
 from ..mechanics.erection import ErectionProblem
 from ..mechanics.fields import COMPRESSION_TOLERANCE
@@ -104,14 +104,15 @@ def node_normals(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
     nodes' lumped areas ``(n,)`` (each cell's area shared equally by its nodes)."""
     normals = np.zeros((mesh.num_points, 3))
     lumped = np.zeros(mesh.num_points)
-    for cell_type, cells in mesh.cells.items():
-        element = ELEMENTS[cell_type]
-        j = element.jacobians(mesh.points, cells)
-        vector = np.einsum("mqi,q->mi", np.cross(j[..., 0], j[..., 1]), element.quadrature_weights)
-        area = np.linalg.norm(vector, axis=1)
+    vectors = mesh.area_vectors()
+    areas = np.linalg.norm(vectors, axis=1)
+    start = 0
+    for cells in mesh.cells.values():
+        mine = slice(start, start + len(cells))
         for a in range(cells.shape[1]):
-            np.add.at(normals, cells[:, a], vector)
-            np.add.at(lumped, cells[:, a], area / cells.shape[1])
+            np.add.at(normals, cells[:, a], vectors[mine])
+            np.add.at(lumped, cells[:, a], areas[mine] / cells.shape[1])
+        start += len(cells)
     return normals / np.linalg.norm(normals, axis=1, keepdims=True), lumped
 
 

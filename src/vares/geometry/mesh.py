@@ -163,6 +163,18 @@ class SurfaceMesh:
             self._areas.setflags(write=False)
         return self._areas
 
+    def area_vectors(self) -> np.ndarray:
+        """Every cell's ``∫ ∂x/∂ξ₁ × ∂x/∂ξ₂``, ``(num_cells, 3)`` in global cell order: its area
+        along its unit normal for a flat cell (a warped quad's is a little shorter); the normals
+        follow the cells' orientation."""
+        vectors = []
+        for cell_type, cells in self._cells.items():
+            element = ELEMENTS[cell_type]
+            j = element.jacobians(self._points, cells)
+            normal = np.cross(j[..., 0], j[..., 1])
+            vectors.append(np.einsum("mqi,q->mi", normal, element.quadrature_weights))
+        return np.vstack(vectors)
+
     @property
     def area(self) -> float:
         """Total 3D surface area."""

@@ -127,14 +127,8 @@ def _figure(size: tuple[float, float]):
     return fig, ax
 
 
-def _cells(ax, image: CellImage, values, norm=None, cmap=None):
-    """The cells as an image: per-cell ``values`` through ``norm`` and ``cmap``, or one colour."""
-    if values is None:
-        values, cmap, norm = (
-            np.zeros(max(int(image.index.max()) + 1, 1)),
-            ListedColormap([_FACE]),
-            None,
-        )
+def _cells(ax, image: CellImage, values: np.ndarray, norm=None, cmap=None):
+    """The cells as an image, per-cell ``values`` through ``norm`` and ``cmap``."""
     return ax.imshow(
         image.lookup(values),
         extent=image.extent,
@@ -179,7 +173,7 @@ def plot_pattern(
     fig = ax.figure
     image = rasterise(mesh.cells, coordinates)
     if values is None:
-        _cells(ax, image, None)
+        _cells(ax, image, np.zeros(mesh.num_cells), cmap=ListedColormap([_FACE]))
         if mesh.num_cells <= MESH_LINES_UP_TO:
             lines = LineCollection(
                 coordinates[mesh.edges()], colors=_LINES, linewidths=0.2, rasterized=True
@@ -231,11 +225,11 @@ class _SurfaceView:
     small triad of the model axes."""
 
     def __init__(self, mesh: SurfaceMesh, ax, view: View):
-        self.mesh, self.ax, self.view = mesh, ax, view
+        self.ax, self.view = ax, view
         self.screen, self.depth = view.project(mesh.points)
         self.image = rasterise(mesh.cells, self.screen, self.depth)
-        normals = _cell_normals(mesh)
-        self.shade = 0.55 + 0.45 * np.abs(normals @ view.axes()[2])
+        facing = mesh.area_vectors() @ view.axes()[2]
+        self.shade = 0.55 + 0.45 * np.abs(facing) / np.maximum(mesh.cell_areas(), 1e-300)
 
     def cells(self, colours: np.ndarray) -> None:
         """Per-cell RGBA colours ``(cells, 4)``, shaded."""
@@ -280,19 +274,6 @@ def _view_size(mesh: SurfaceMesh, view: View, width: float, drawing: float) -> t
     across, high = np.ptp(view.project(mesh.points)[0], axis=0)
     aspect = float(np.clip(high / across, 0.35, 1.5)) if across > 0 else 1.0
     return width, 0.9 + drawing * aspect
-
-
-def _cell_normals(mesh: SurfaceMesh) -> np.ndarray:
-    """Unit normal of every cell (global order), from its diagonals (triangles: two edges)."""
-    normals = []
-    for cells in mesh.cells.values():
-        p = mesh.points[cells]
-        if cells.shape[1] == 3:
-            n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        else:
-            n = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
-        normals.append(n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300))
-    return np.vstack(normals)
 
 
 def plot_surface(
