@@ -108,3 +108,40 @@ def test_radial_strips_of_a_tent_with_their_own_warps():
     kinds = set(itertools.chain.from_iterable(o.edges for o in result.outlines))
     assert kinds == {"seam", "free", "clamp"}
     assert result.nest is not None and result.nest.length > 0
+
+
+def test_cutting_along_the_users_lines_from_the_api_the_command_and_a_job(tmp_path):
+    """Two straight rulings of the hypar along mesh lines as the user's cutting lines: three
+    strips whose seams are those lines (3D length 10·√(1 + (0.06·5/3)²)); lines are refused without
+    seams = 'curves' and a job with seams = 'curves' needs its file."""
+    mesh = vares.examples.hypar(size=10.0, rise=0.06, n=12)
+    x = np.linspace(-5.0, 5.0, 9)
+    lines = [np.column_stack([x, np.full_like(x, y), 0.06 * x * y]) for y in (-5 / 3, 5 / 3)]
+    result = vares.cut(
+        mesh, FABRIC, roll_width=5.0, seams="curves", lines=lines, nest_time=1, max_iterations=30
+    )
+    assert result.converged and len(result.plan.panels) == 3 and result.nest is not None
+    ruling = 10.0 * np.sqrt(1.0 + (0.06 * 5 / 3) ** 2)
+    assert [s.length_3d for s in result.seams] == pytest.approx([ruling, ruling], rel=1e-9)
+    with pytest.raises(ValueError, match="go together"):
+        vares.cut(mesh, FABRIC, roll_width=5.0, lines=lines)
+    with pytest.raises(ValueError, match="go together"):
+        vares.cut(mesh, FABRIC, roll_width=5.0, seams="curves")
+    # the same lines from a file, on the command line
+    source = tmp_path / "hypar.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    drawn = tmp_path / "lines.txt"
+    drawn.write_text("\n\n".join("\n".join(f"{a} {b} {c}" for a, b, c in line) for line in lines))
+    out = tmp_path / "out"
+    result = run("cut", source, "--roll-width", 5, "--seams", drawn, "-o", out, "--nest-time", 1)
+    assert result.exit_code == 0, result.stderr
+    seams = json.loads((out / "cut.json").read_text())["seams"]
+    assert [s["length_3d"] for s in seams] == pytest.approx([ruling, ruling], rel=1e-9)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        f'[input]\nmesh = "{source}"\n[cut]\nroll_width = 5.0\nseams = "curves"\n'
+        '[output]\ndirectory = "job-out"\n'
+    )
+    result = run("run", job)
+    assert result.exit_code == 2 and "needs a curves file" in error_line(result)
+    assert not (tmp_path / "job-out").exists()

@@ -15,7 +15,7 @@ from vares.geometry.outline import allowance_outline
 from vares.geometry.surface_lines import CuttingError, geodesic_lines, plane_sections
 from vares.structures import find_seams, split_panels
 from vares.structures.layout import plan_strips
-from vares.structures.nesting import nest_pieces
+from vares.structures.nesting import nest_pieces, usable_width
 
 
 def developed(line, flat: np.ndarray) -> np.ndarray:
@@ -180,6 +180,21 @@ def test_nesting_never_overlaps_and_stays_on_the_roll(turn):
     assert bounds[:, 1].min() >= 0 and bounds[:, 3].max() <= 2.5 and bounds[:, 0].min() >= 0
     assert nest.length == pytest.approx(bounds[:, 2].max())
     assert nest.yield_ == pytest.approx(sum(areas) / (2.5 * nest.length))
-    assert 0 < nest.yield_ <= 1
-    if not turn:
-        assert all(p.rotation == 0 for p in nest.pieces)
+    # two rows fit across the roll: far shorter than the pieces laid end to end
+    assert nest.length < 0.6 * sum(np.ptp(p[:, 0]) for p in pieces)
+    assert all(p.rotation in ((0.0, 180.0) if turn else (0.0,)) for p in nest.pieces)
+
+
+def test_a_piece_as_wide_as_the_roll_is_refused_by_the_nest_as_by_the_cut():
+    """``cut`` and the nesting agree on the widest piece (``usable_width``): a piece exactly as
+    wide as the roll is refused before the search, one at the usable width is laid."""
+    roll = 2.0
+    square = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, roll], [0.0, roll]])
+    for width in (roll, 0.5 * (roll + usable_width(roll))):
+        with pytest.raises(ValueError, match="takes at most"):
+            nest_pieces([square * [1.0, width / roll]], roll, net_areas=[6.0], time_limit=1)
+    fitting = square * [1.0, usable_width(roll) / roll]
+    nest = nest_pieces([fitting], roll, net_areas=[Polygon(fitting).area], time_limit=1)
+    placed = Polygon(nest.pieces[0].place(fitting))
+    assert placed.bounds[1] >= 0 and placed.bounds[3] <= roll
+    assert nest.length == pytest.approx(3.0, rel=1e-9)

@@ -327,17 +327,19 @@ def _solve_cut(job, source: Input, material, options, callback) -> JobOutcome:
 
     if job.prestress.field is not None:
         raise JobError("per-cell prestress is not available for cut jobs yet")
-    curves = None
+    lines = None
     if job.cut.seams == "curves":
         from ..io.curves import read_curves
 
-        curves = read_curves(job.path(job.cut.curves), layer=job.cut.curves_layer)
+        if job.cut.curves is None:
+            raise JobError("[cut] seams = 'curves' needs a curves file: curves = \"FILE\"")
+        lines = read_curves(job.path(job.cut.curves), layer=job.cut.curves_layer)
     result = cut(
         source.panels[0].mesh,
         material,
         job.material.thickness,
         prestress=job.prestress.value({}),
-        curves=curves,
+        lines=lines,
         allowance=job.output.allowance,
         units=source.units,
         dxf_units=job.output.dxf_units,
@@ -349,10 +351,10 @@ def _solve_cut(job, source: Input, material, options, callback) -> JobOutcome:
     pairs = zip(result.plan.panels, result.structure.results, strict=True)
     panels = [_panel(job, source, p.name, p.mesh, r) for p, r in pairs]
     warnings = [
-        f"{p.name} is {w:.4g} {source.units} wide across the warp with its allowances, more "
-        f"than the roll width {job.cut.roll_width:g}"
-        for p, w in zip(result.plan.panels, result.widths, strict=True)
-        if w > job.cut.roll_width
+        f"{result.plan.panels[k].name} is {result.widths[k]:.6g} {source.units} wide across the "
+        f"warp with its allowances; the roll ({job.cut.roll_width:g}) takes at most "
+        f"{result.usable_width:.6g}"
+        for k in result.too_wide
     ]
     if warnings and result.structure.converged:
         warnings.append("no nest: a piece wider than the roll cannot be laid on it")

@@ -71,6 +71,7 @@ def _insert(mesh: SurfaceMesh, located, snap: float):
     """Put the located points into the mesh as nodes; the ends onto the boundary."""
     triangles = mesh.cells["triangle"]
     boundary = {tuple(sorted(e)) for e in mesh.boundary_edges().tolist()}
+    boundary_nodes = {node for edge in boundary for node in edge}
     points = mesh.points
     single = []  # one-point lines for cut_mesh: edge locations
     inner_faces, inner_bary, slots = [], [], []
@@ -80,6 +81,12 @@ def _insert(mesh: SurfaceMesh, located, snap: float):
             end = k in (0, len(faces) - 1)
             if end:
                 a, b, t = _nearest_boundary_edge(points, corners, weights, boundary)
+                if a is None and weights.max() > 1.0 - snap:  # at a corner on the boundary
+                    node = int(corners[np.argmax(weights)])
+                    if node in boundary_nodes:
+                        a, b, t = node, node, 0.0
+                if a is None:
+                    raise _away_from_boundary(weights @ points[corners])
             else:
                 a, b, t = _on_edge(corners, weights, snap)
             if a is None:
@@ -119,8 +126,16 @@ def _on_edge(corners, weights, snap):
     return None, None, None
 
 
+def _away_from_boundary(position: np.ndarray) -> CuttingError:
+    return CuttingError(
+        f"a curve ends at ({position[0]:.6g}, {position[1]:.6g}, {position[2]:.6g}), away "
+        "from the surface's boundary: cutting lines run from boundary to boundary"
+    )
+
+
 def _nearest_boundary_edge(points, corners, weights, boundary):
-    """The point moved onto the closest boundary edge of its cell (the curve's end)."""
+    """The point moved onto the closest boundary edge of its cell (the curve's end), or
+    ``(None, None, None)`` when the cell has none."""
     position = weights @ points[corners]
     best = None
     for k in range(3):
@@ -133,10 +148,7 @@ def _nearest_boundary_edge(points, corners, weights, boundary):
         if best is None or distance < best[0]:
             best = (distance, a, b, t)
     if best is None:
-        raise CuttingError(
-            f"a curve ends at ({position[0]:.6g}, {position[1]:.6g}, {position[2]:.6g}), away "
-            "from the surface's boundary: cutting lines run from boundary to boundary"
-        )
+        return None, None, None
     return best[1], best[2], best[3]
 
 

@@ -27,7 +27,7 @@ from ..solver import IterationRecord, SolveOptions
 from ..units import unit_factor
 from .layout import StripPlan, plan_strips, strips_along_lines, width_across
 from .matching import StructureResult, solve_structure
-from .nesting import RollNest, nest_pieces
+from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
 
 __all__ = ["CutResult", "PieceOutline", "SeamLine", "cut"]
@@ -91,6 +91,16 @@ class CutResult:
         return self.structure.converged
 
     @property
+    def usable_width(self) -> float:
+        """The widest piece the roll takes (:func:`~vares.structures.nesting.usable_width`)."""
+        return usable_width(self.options.roll_width)
+
+    @property
+    def too_wide(self) -> list[int]:
+        """The strips whose pattern, allowances included, the roll does not take."""
+        return [k for k, width in enumerate(self.widths) if width > self.usable_width]
+
+    @property
     def panel_area(self) -> float:
         """Total 3D area of the panels."""
         return float(sum(p.mesh.area for p in self.plan.panels))
@@ -103,7 +113,7 @@ def cut(
     thickness: float = 1.0,
     *,
     prestress: float | Sequence[float] | None = None,
-    curves: Sequence[np.ndarray] | None = None,
+    lines: Sequence[np.ndarray] | None = None,
     allowance: float = 0.0,
     units: str = "m",
     dxf_units: str = "mm",
@@ -111,34 +121,34 @@ def cut(
     structure: StructureOptions | None = None,
     cutting: CutOptions | None = None,
     callback: Callable[[IterationRecord], None] | None = None,
-    before_solve: Callable[[StripPlan], None] | None = None,
     **settings: Any,
 ) -> CutResult:
     """Cut a surface into strips of roll width, pattern them with matched seams and nest them.
 
     ``roll_width`` (an option, below) is in the mesh's ``units``; ``allowance`` (the seam
     allowance) and the edge allowances are in ``dxf_units``, as on the cutter's drawing.
-    ``curves`` are the user's cutting lines (polylines ``(k, 3)`` near the surface) when
-    ``seams = "curves"``. The warp runs along each strip unless ``warp_direction`` is given;
-    ``before_solve`` is told every plan before its patterns are computed.
+    ``lines`` are the user's cutting lines (polylines ``(k, 3)`` near the surface), given
+    with ``seams = "curves"`` (a job names a file of them instead: option ``curves``). The
+    warp runs along each strip unless ``warp_direction`` is given.
     """
     mine = {k: settings.pop(k) for k in list(settings) if k in CutOptions.specs()}
     cutting = cutting.replace(**mine) if cutting is not None else CutOptions(**mine)
     options, structure = split_settings(
         settings, [options or SolveOptions(), structure or StructureOptions()]
     )
+    if (cutting.seams == "curves") != (lines is not None):
+        raise ValueError("seams = 'curves' and the cutting lines (lines=[…]) go together")
     started = time.perf_counter()
     scale = unit_factor(dxf_units, units)
+    usable = usable_width(cutting.roll_width)
     allowances = {
         kind: scale * cutting.allowance(kind, allowance)
         for kind in ("seam", "free", "cable", "clamp")
     }
     surface = triangulated(mesh)
-    target, rounds = cutting.roll_width, []
+    target, rounds = usable, []
     for _ in range(MAX_ROUNDS):
-        plan = _plan(surface, target, cutting, allowances, options, curves)
-        if before_solve is not None:
-            before_solve(plan)
+        plan = _plan(surface, target, cutting, allowances, options, lines)
         own = [
             {} if options.warp_direction is not None else {"warp_direction": tuple(w)}
             for w in plan.warps
@@ -159,12 +169,12 @@ def cut(
             for o, r in zip(outlines, result.results, strict=True)
         ]
         rounds.append(max(widths))
-        if not result.converged or max(widths) <= cutting.roll_width or curves is not None:
+        if not result.converged or max(widths) <= usable or lines is not None:
             break
         # the flattened widths underestimated the patterns': ask the flattening for less
-        target = max(plan.widths) * cutting.roll_width / max(widths) * (1.0 - 1e-3)
+        target = max(plan.widths) * usable / max(widths) * (1.0 - 1e-3)
     nest = None
-    if result.converged and max(widths) <= cutting.roll_width:
+    if result.converged and max(widths) <= usable:
         nest = nest_pieces(
             [o.cut for o in outlines],
             cutting.roll_width,
@@ -192,12 +202,12 @@ def cut(
     )
 
 
-def _plan(surface, target, cutting: CutOptions, allowances, options, curves) -> StripPlan:
+def _plan(surface, target, cutting: CutOptions, allowances, options, lines) -> StripPlan:
     if cutting.seams == "curves":
         from ..geometry.drawn_lines import curves_on_surface
 
-        base, lines = curves_on_surface(surface, curves or [], cutting.snap)
-        return strips_along_lines(base, lines, cutting.snap, options.warp_direction)
+        base, on_surface = curves_on_surface(surface, lines, cutting.snap)
+        return strips_along_lines(base, on_surface, cutting.snap, options.warp_direction)
     edge_kind = cutting.edge_type
     return plan_strips(
         surface,

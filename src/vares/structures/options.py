@@ -137,8 +137,8 @@ class CutOptions(Options):
     )
 
     def check(self) -> None:
-        if (self.seams == "curves") != (self.curves is not None):
-            raise OptionsError(None, "seams = 'curves' and a curves file go together")
+        if self.curves is not None and self.seams != "curves":
+            raise OptionsError(None, "a curves file goes with seams = 'curves'")
         if self.curves_layer is not None and self.curves is None:
             raise OptionsError(None, "curves_layer needs a curves file")
         if self.snap >= 0.5:
