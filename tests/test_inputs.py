@@ -323,3 +323,51 @@ def test_dxf_layers_name_the_panels_of_a_structure(tmp_path):
     assert structure["converged"]
     assert sorted(p["name"] for p in structure["panels"]) == ["EAST", "MIDDLE", "WEST"]
     assert all((tmp_path / "out" / name / "pattern.dxf").is_file() for name in ("EAST", "WEST"))
+
+
+def test_a_non_convex_polygon_is_cut_into_triangles_that_tile_it():
+    """An L-shaped face with thin arms (the shape whose best-fit normal came out reversed
+    without the closing edge's term): every triangle faces the polygon's way and their areas
+    add up to the polygon's, so none overlaps another."""
+    from vares.geometry.repair import triangulate_polygon
+
+    outline = np.array([[0, 0], [2, 0], [2, 0.1], [0.1, 0.1], [0.1, 2], [0, 2]], dtype=float)
+    tilt = np.radians(20.0)
+    points = np.column_stack(
+        [outline[:, 0], outline[:, 1] * np.cos(tilt), outline[:, 1] * np.sin(tilt)]
+    )
+    triangles = triangulate_polygon(points, np.arange(len(points)))
+    assert triangles.shape == (4, 3)
+    p = points[triangles]
+    normals = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    facing = normals @ np.array([0.0, -np.sin(tilt), np.cos(tilt)])
+    assert np.all(facing > 0)
+    assert 0.5 * np.linalg.norm(normals, axis=1).sum() == pytest.approx(2 * 0.1 + 1.9 * 0.1)
+
+
+def test_zero_area_cells_are_dropped_only_on_the_boundary_of_the_whole_mesh():
+    """On a 3 × 2 grid of quads: a zero-area triangle on the boundary is dropped; one inside,
+    every edge shared with a quad of the other block, stays (the validation names it); a quad
+    with a straight corner but an area is kept whatever corner is straight."""
+    x, y = np.meshgrid(np.arange(4.0), np.arange(3.0))
+    grid = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    quads = [[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [4, 5, 9, 8], [6, 7, 11, 10]]
+    points = np.vstack([grid, [[1.5, 0.0, 0.0]]])  # node 12 on the boundary edge 1–2
+    cells = {"quad": np.array([*quads, [5, 6, 10, 9]]), "triangle": np.array([[2, 12, 1]])}
+    fixed = repair(points, cells)
+    assert fixed.report.flat_boundary_cells == 1 and "triangle" not in fixed.cells
+    # the edge 5–6 split at node 12 above; the flat triangle 6–12–5 between the two rows
+    points = np.vstack([grid, [[1.5, 1.0, 0.0], [1.5, 2.0, 0.0]]])
+    cells = {
+        "quad": np.array([*quads, [5, 12, 13, 9], [12, 6, 10, 13]]),
+        "triangle": np.array([[6, 12, 5]]),
+    }
+    fixed = repair(points, cells)
+    assert fixed.report.flat_boundary_cells == 0 and len(fixed.cells["triangle"]) == 1
+    with pytest.raises(vares.MeshError, match="triangle cells 0"):
+        vares.SurfaceMesh(fixed.points, fixed.cells)
+    # a quad of area 0.5 whose corner 0 is straight (its neighbours in line), on the boundary
+    points = np.vstack([grid, [[4.0, 0.0, 0.0], [3.5, 0.5, 0.0]]])
+    cells = {"quad": np.array([*quads, [5, 6, 10, 9], [13, 7, 3, 12]])}
+    fixed = repair(points, cells)
+    assert fixed.report.flat_boundary_cells == 0 and len(fixed.cells["quad"]) == 7

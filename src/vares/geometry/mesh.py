@@ -238,20 +238,10 @@ class SurfaceMesh:
                 parts.append(f"{t} cells {_listing(np.unique(mine))}")
         return "; ".join(parts)
 
-    def _directed_edges(self) -> tuple[np.ndarray, np.ndarray]:
-        """All directed cell edges ``(k, 2)`` and the global cell each belongs to."""
-        edges, owner = [], []
-        for _t, a, offset in self._global_cells():
-            nen = a.shape[1]
-            for i in range(nen):
-                edges.append(np.column_stack([a[:, i], a[:, (i + 1) % nen]]))
-                owner.append(offset + np.arange(len(a)))
-        return np.vstack(edges), np.concatenate(owner)
-
     def _edge_table(self) -> _EdgeTable:
         """The edge table (computed once: the mesh does not change)."""
         if self._edges is None:
-            self._edges = _EdgeTable.of(self._directed_edges(), self.num_points)
+            self._edges = _EdgeTable.of_cells(self._cells, self.num_points)
         return self._edges
 
     def _validate(self) -> None:
@@ -385,6 +375,11 @@ class _EdgeTable:
     order: np.ndarray
 
     @classmethod
+    def of_cells(cls, cells: Mapping[str, np.ndarray], num_points: int) -> _EdgeTable:
+        """The table of cell blocks by type (global cell order: block after block)."""
+        return cls.of(directed_edges(cells), num_points)
+
+    @classmethod
     def of(cls, edges: tuple[np.ndarray, np.ndarray], num_points: int) -> _EdgeTable:
         directed, owner = edges
         key = np.minimum(directed[:, 0], directed[:, 1]) * num_points + np.maximum(
@@ -405,18 +400,26 @@ class _EdgeTable:
         return self.order[pair_start], self.order[pair_start + 1]
 
 
-def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.ndarray:
-    """The piece (0, 1, …) of every cell (global cell order): cells are in one piece when a
-    chain of shared edges joins them; the largest piece is 0."""
-    directed, owner = [], []
-    offset = 0
+def directed_edges(cells: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Every directed edge ``(k, 2)`` of the cell blocks (edge ``i`` of every cell of a block,
+    then edge ``i + 1``, block after block) and the global cell each belongs to."""
+    edges, owner, offset = [], [], 0
     for block in cells.values():
         nen = block.shape[1]
         for i in range(nen):
-            directed.append(np.column_stack([block[:, i], block[:, (i + 1) % nen]]))
+            edges.append(np.column_stack([block[:, i], block[:, (i + 1) % nen]]))
             owner.append(offset + np.arange(len(block)))
         offset += len(block)
-    table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), len(points))
+    if not edges:
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.vstack(edges), np.concatenate(owner)
+
+
+def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.ndarray:
+    """The piece (0, 1, …) of every cell (global cell order): cells are in one piece when a
+    chain of shared edges joins them; the largest piece is 0."""
+    offset = sum(len(block) for block in cells.values())
+    table = _EdgeTable.of_cells(cells, len(points))
     first, second = table.pairs()
     adjacency = sp.coo_matrix(
         (np.ones(first.size), (table.owner[first], table.owner[second])), shape=(offset, offset)

@@ -27,6 +27,7 @@ from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 from scipy.spatial import cKDTree
 
+from .elements import ELEMENTS
 from .mesh import MeshError, _EdgeTable, _listing, corner_fans
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
@@ -136,12 +137,13 @@ def repair(
         counts.update(welded_nodes=int(points.shape[0] - np.unique(mapping).size))
         counts.update(weld_tolerance=tolerance)
         blocks = {t: mapping[b] for t, b in blocks.items()}
-        blocks, owners, counts["collapsed_cells"] = _drop(blocks, owners, _collapsed)
-        blocks, owners, counts["duplicate_cells"] = _drop(blocks, owners, _duplicates)
-        blocks, owners, counts["flat_boundary_cells"] = _drop(
-            blocks, owners, lambda b: _flat_on_boundary(points, b)
-        )
-        blocks, counts["flipped_cells"] = _orient(blocks)
+        marked = {t: _collapsed(b) for t, b in blocks.items()}
+        blocks, owners, counts["collapsed_cells"] = _drop(blocks, owners, marked)
+        marked = {t: _duplicates(b) for t, b in blocks.items()}
+        blocks, owners, counts["duplicate_cells"] = _drop(blocks, owners, marked)
+        marked = _flat_on_boundary(points, blocks)
+        blocks, owners, counts["flat_boundary_cells"] = _drop(blocks, owners, marked)
+        blocks, counts["flipped_cells"] = _orient(blocks, len(points))
         points, blocks, counts["split_nodes"] = _split_bow_ties(points, blocks)
     used = np.zeros(len(points), dtype=bool)
     for block in blocks.values():
@@ -180,19 +182,15 @@ def _weld_map(points: np.ndarray, tolerance: float) -> np.ndarray:
     return first[label]
 
 
-def _drop(blocks, owners, condition):
-    """Blocks and owners without the cells ``condition(block)`` marks, and how many there were."""
+def _drop(blocks, owners, marked):
+    """Blocks and owners without the cells ``marked`` (a mask per block), and how many."""
     dropped = 0
     out_blocks, out_owners = {}, {}
     for cell_type, block in blocks.items():
-        bad = condition(block) if len(block) else np.zeros(0, dtype=bool)
+        bad = marked[cell_type]
         dropped += int(bad.sum())
         out_blocks[cell_type], out_owners[cell_type] = block[~bad], owners[cell_type][~bad]
     return out_blocks, out_owners, dropped
-
-
-def _num_nodes(blocks: dict[str, np.ndarray]) -> int:
-    return int(max((b.max() for b in blocks.values() if b.size), default=-1)) + 1
 
 
 def _collapsed(block: np.ndarray) -> np.ndarray:
@@ -209,41 +207,35 @@ def _duplicates(block: np.ndarray) -> np.ndarray:
     return duplicate
 
 
-def _flat_on_boundary(points: np.ndarray, block: np.ndarray) -> np.ndarray:
-    """Zero-area cells with an edge on the boundary whose other corners are interior."""
-    corners = points[block]
+def _flat_on_boundary(points: np.ndarray, blocks: dict[str, np.ndarray]) -> dict:
+    """Zero-area cells with an edge on the boundary, a mask per block; the boundary is that of
+    all the blocks together. (A quad with a straight corner has an area: it is kept, and the
+    validation names it.)"""
     scale = float(np.ptp(points, axis=0).max()) or 1.0
-    area = np.linalg.norm(
-        np.cross(corners[:, 1] - corners[:, 0], corners[:, -1] - corners[:, 0]), axis=1
-    )
-    flat = area <= _FLAT * scale**2
-    if not flat.any():
+    flat = {
+        t: ELEMENTS[t].areas(points, b) <= _FLAT * scale**2 if len(b) else np.zeros(0, dtype=bool)
+        for t, b in blocks.items()
+    }
+    if not any(mask.any() for mask in flat.values()):
         return flat
-    edges = np.sort(np.stack([block, np.roll(block, -1, axis=1)], axis=-1), axis=-1)
-    keys, counts = np.unique(edges.reshape(-1, 2), axis=0, return_counts=True)
-    boundary = {tuple(k) for k in keys[counts == 1]}
-    on_boundary = np.array(
-        [any(tuple(e) in boundary for e in cell_edges) for cell_edges in edges[flat]]
-    )
-    flat[np.flatnonzero(flat)[~on_boundary]] = False
+    table = _EdgeTable.of_cells(blocks, len(points))
+    at_boundary = np.zeros(sum(len(b) for b in blocks.values()), dtype=bool)
+    at_boundary[table.owner[table.counts[table.edge_id] == 1]] = True
+    start = 0
+    for t, block in blocks.items():
+        flat[t] &= at_boundary[start : start + len(block)]
+        start += len(block)
     return flat
 
 
-def _orient(blocks: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], int]:
+def _orient(blocks: dict[str, np.ndarray], num_points: int) -> tuple[dict[str, np.ndarray], int]:
     """Flip cells so that neighbours traverse their shared edge in opposite directions; within
     each piece the orientation of the majority of cells is kept. Non-manifold edges are skipped
     (the validation names them)."""
-    sizes = [len(b) for b in blocks.values()]
-    if not sum(sizes):
+    total = sum(len(b) for b in blocks.values())
+    if not total:
         return blocks, 0
-    directed, owner = [], []
-    offset = 0
-    for block in blocks.values():
-        for i in range(block.shape[1]):
-            directed.append(np.column_stack([block[:, i], block[:, (i + 1) % block.shape[1]]]))
-            owner.append(offset + np.arange(len(block)))
-        offset += len(block)
-    table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), _num_nodes(blocks))
+    table = _EdgeTable.of_cells(blocks, num_points)
     directed, owner, counts = table.directed, table.owner, table.counts
     a, b = table.pairs()
     manifold = counts[table.edge_id[a]] == 2
@@ -251,7 +243,6 @@ def _orient(blocks: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], int]:
     same = (directed[a, 0] == directed[b, 0]).astype(np.int8)
     if not same.any():
         return blocks, 0
-    total = offset
     graph = sp.coo_matrix(
         (
             np.concatenate([same + 1, same + 1]),
@@ -281,20 +272,14 @@ def _orient(blocks: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], int]:
 def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
     """A new node for every fan of cells at a node beyond its first (module docs)."""
     names = list(blocks)
-    directed, owner, block_of, row_of, col_of = [], [], [], [], []
-    offset = 0
-    for index, block in enumerate(blocks.values()):
-        nen = block.shape[1]
-        for i in range(nen):
-            directed.append(np.column_stack([block[:, i], block[:, (i + 1) % nen]]))
-            owner.append(offset + np.arange(len(block)))
-            block_of.append(np.full(len(block), index))
-            row_of.append(np.arange(len(block)))
-            col_of.append(np.full(len(block), i))
-        offset += len(block)
-    if not offset:
+    if not sum(len(b) for b in blocks.values()):
         return points, blocks, 0
-    table = _EdgeTable.of((np.vstack(directed), np.concatenate(owner)), len(points))
+    table = _EdgeTable.of_cells(blocks, len(points))
+    # the block, row and column (corner) of every directed edge's start, in the table's order
+    offsets = np.cumsum([0, *(len(b) for b in blocks.values())])
+    block_of = np.concatenate([np.full(b.size, k) for k, b in enumerate(blocks.values())])
+    col_of = np.concatenate([np.repeat(np.arange(b.shape[1]), len(b)) for b in blocks.values()])
+    row_of = table.owner - offsets[block_of]
     node, fan = corner_fans(len(points), table.directed, table.owner, table.edge_id, table.order)
     fans = int(fan.max()) + 1 if fan.size else 1
     keys, label = np.unique(node.astype(np.int64) * fans + fan, return_inverse=True)
@@ -305,7 +290,7 @@ def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
     new_node = np.full(len(pairs), -1)
     new_node[extra] = len(points) + np.arange(extra.sum())
     moved = new_node[label.ravel()] >= 0
-    block_of, row_of, col_of = (np.concatenate(a)[moved] for a in (block_of, row_of, col_of))
+    block_of, row_of, col_of = block_of[moved], row_of[moved], col_of[moved]
     out = {name: block.copy() for name, block in blocks.items()}
     targets = new_node[label.ravel()[moved]]
     for index, name in enumerate(names):
@@ -332,16 +317,14 @@ def triangulate_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     the polygon's best-fit plane; the triangles keep the polygon's orientation."""
     corners = points[polygon]
     centred = corners - corners.mean(axis=0)
-    normal = np.cross(centred[:-1], centred[1:]).sum(axis=0)
+    normal = np.cross(centred, np.roll(centred, -1, axis=0)).sum(axis=0)  # Newell's
     normal = normal / (np.linalg.norm(normal) or 1.0)
     u = np.linalg.svd(centred - np.outer(centred @ normal, normal))[2][0]
     v = np.cross(normal, u)
     flat = np.column_stack([centred @ u, centred @ v])
     remaining = list(range(len(polygon)))
     out = []
-    guard = 0
-    while len(remaining) > 3 and guard < 10 * len(polygon):
-        guard += 1
+    while len(remaining) > 3:
         for k in range(len(remaining)):
             i, j, m = remaining[k - 1], remaining[k], remaining[(k + 1) % len(remaining)]
             if _is_ear(flat, i, j, m, remaining):
