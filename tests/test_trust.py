@@ -154,8 +154,13 @@ def test_nothing_in_an_output_folder_is_lost(tmp_path):
     write_surface(out / "roof.obj", mesh)  # the input lies in the output folder
     result = run("pattern", out / "roof.obj", "-o", out, "-q", "--force")
     assert result.exit_code == 2
-    assert "holds files vares did not write (roof.obj)" in error_line(result)
+    assert "roof.obj lies in the output folder, which the run replaces" in error_line(result)
     assert sorted(p.name for p in out.iterdir()) == ["roof.obj"]
+    (out / "notes.txt").write_text("mine")
+    write_surface(tmp_path / "x.obj", mesh)
+    result = run("pattern", tmp_path / "x.obj", "-o", out, "-q", "--force")
+    assert result.exit_code == 2
+    assert "holds files vares did not write (notes.txt, roof.obj)" in error_line(result)
     (tmp_path / "file").write_text("not a folder")
     result = run("pattern", out / "roof.obj", "-o", tmp_path / "file", "-q")
     assert result.exit_code == 2 and "is a file" in error_line(result)
@@ -172,6 +177,11 @@ def test_nothing_in_an_output_folder_is_lost(tmp_path):
     result = run("run", job, "-q", "--force")
     assert result.exit_code == 0, result.stderr
     assert job.exists() and (tmp_path / "run" / "pattern.dxf").exists()
+    # another run's job file is not overwritten, even with --force
+    saved = job.read_text()
+    other = run("pattern", out / "roof.obj", "-o", tmp_path / "y", "--save-job", job, "-f")
+    assert other.exit_code == 2 and "belongs to another run's folder" in error_line(other)
+    assert job.read_text() == saved and not (tmp_path / "y").exists()
 
 
 def test_a_scans_flipped_slivers_are_mended_in_its_projection():
@@ -185,3 +195,53 @@ def test_a_scans_flipped_slivers_are_mended_in_its_projection():
     assert from_tutte.converged
     assert mended.energy == pytest.approx(from_tutte.energy, rel=1e-9)  # the same optimum
     assert mended.iterations < from_tutte.iterations
+
+
+def test_a_file_that_appears_during_a_run_is_not_lost(tmp_path, monkeypatch):
+    """The folder is checked again just before the run takes its place: a file put there
+    meanwhile stays, the previous run too, and the new run waits beside them."""
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    from vares.app import staging
+
+    start = staging.OutputFolder.start
+
+    def meanwhile(self):
+        staged = start(self)
+        (out / "notes.txt").write_text("written during the run")
+        return staged
+
+    monkeypatch.setattr(staging.OutputFolder, "start", meanwhile)
+    result = run("example", "hypar", "-o", out, "-q", "--force", "--E", "2000")
+    assert result.exit_code == 2 and "(notes.txt)" in error_line(result)
+    assert "this run is kept in" in error_line(result)
+    after = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert after.pop("notes.txt") == b"written during the run" and after == before
+    kept = [p for p in tmp_path.iterdir() if p.name.startswith(".out.vares-")]
+    assert len(kept) == 1 and (kept[0] / "pattern.dxf").is_file()
+
+
+def test_an_erection_rerun_lists_only_its_own_files(tmp_path):
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    assert run("erect", out, "-q", "--report").exit_code == 0
+    assert (out / "erect" / "report.html").is_file()
+    assert run("erect", out, "-q", "-f").exit_code == 0  # without the report this time
+    listed = json.loads((out / ".vares-run.json").read_text())["files"]
+    assert "erect/erect.json" in listed and "erect/report.html" not in listed
+    assert not (out / "erect" / "report.html").exists()
+    (out / "erect" / "report.html").write_text("the user's own page")
+    result = run("erect", out, "-q", "-f")
+    assert result.exit_code == 2 and "(report.html)" in error_line(result)
+    assert (out / "erect" / "report.html").read_text() == "the user's own page"
+
+
+def test_batch_jobs_whose_folders_nest_are_refused(tmp_path):
+    for name, folder in (("a", "X"), ("b", "X/b")):
+        (tmp_path / f"{name}.toml").write_text(
+            f'[input]\nexample = "hypar"\n[output]\ndirectory = "{folder}"\n'
+        )
+    result = run("batch", tmp_path / "a.toml", tmp_path / "b.toml")
+    assert result.exit_code == 2 and "one into the other's" in error_line(result)
+    assert not (tmp_path / "X").exists()

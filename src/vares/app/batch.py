@@ -72,11 +72,12 @@ def _refuse_shared_outputs(paths: list[str]) -> None:
             directory = load_job(path).directory.resolve()
         except (OSError, ValueError):
             continue  # reported when the job runs
-        if directory in seen:
-            raise JobError(
-                f"{seen[directory]} and {path} write into the same folder {directory}: "
-                "give each job its own [output] directory"
-            )
+        for other, owner in seen.items():
+            if directory == other or other in directory.parents or directory in other.parents:
+                raise JobError(
+                    f"{owner} and {path} write into the same folder or one into the other's "
+                    f"({other}, {directory}): give each job a folder of its own"
+                )
         seen[directory] = path
 
 

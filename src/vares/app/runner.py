@@ -71,6 +71,8 @@ def run_job(
     if save_job is not None and save_job.resolve() not in folder.planned:
         if save_job.resolve() in folder.inputs:
             raise JobError(f"--save-job {save_job} is an input of the run")
+        if save_job.resolve() in {p.resolve() for p in listed(save_job.parent)}:
+            raise JobError(f"--save-job {save_job} belongs to another run's folder")
         check_writable([save_job], force)
     first = source.panels[0]
     if on_solve_start is not None:
@@ -253,11 +255,12 @@ def run_erection(
             from .erection_report import write_erection_report
 
             staged.append(write_erection_report(result, root, units))
+        files = [folder.directory / Path(p).relative_to(root) for p in staged]
+        # listed first: killed before the commit, the run's folder still knows erect/ is its own
+        add_to_manifest(directory, files, replacing=folder.directory)
         folder.commit()
     finally:
         folder.discard()
-    files = [directory / "erect" / Path(p).relative_to(root) for p in staged]
-    add_to_manifest(directory, files)
     return ErectionRun(job, result, files, units)
 
 

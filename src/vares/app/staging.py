@@ -61,19 +61,16 @@ class OutputFolder:
                 raise OutputExistsError(
                     f"the output {path} is an input of the run: choose another output folder"
                 )
+        for path in self.inputs:  # a job file there is carried over; anything else is replaced
+            if self.directory in path.parents and path.suffix.lower() != ".toml":
+                raise OutputExistsError(
+                    f"the input {path} lies in the output folder, which the run replaces: "
+                    "move it out or choose another output folder"
+                )
         if self.directory.exists() and not self.directory.is_dir():
             raise OutputExistsError(f"the output folder {self.directory} is a file")
         existing = self._existing()
-        ours = self._previous() | {
-            p.relative_to(self.directory) for p in [*self.planned, *self.known]
-        }
-        foreign = sorted(str(p) for p in existing - ours)
-        if foreign:
-            shown = ", ".join(foreign[:4]) + (", …" if len(foreign) > 4 else "")
-            raise OutputExistsError(
-                f"the output folder {self.directory} holds files vares did not write ({shown}); "
-                "they would be lost: choose a new or empty folder"
-            )
+        self._refuse_foreign(existing)
         if existing and not self.force:
             shown = ", ".join(str(self.directory / p) for p in sorted(existing)[:3])
             raise OutputExistsError(
@@ -81,6 +78,19 @@ class OutputFolder:
                 "replace the previous run)"
             )
         self._writable()
+
+    def _refuse_foreign(self, existing: set[Path], kept: str = "") -> None:
+        """Refuse a folder holding files that no run of vares wrote there (they would be
+        lost); ``kept`` says where the finished run waits, when it comes to that at the end."""
+        ours = {p.relative_to(self.directory) for p in listed(self.directory)}
+        ours |= {p.relative_to(self.directory) for p in [*self.planned, *self.known]}
+        foreign = sorted(str(p) for p in existing - ours)
+        if foreign:
+            shown = ", ".join(foreign[:4]) + (", …" if len(foreign) > 4 else "")
+            raise OutputExistsError(
+                f"the output folder {self.directory} holds files vares did not write ({shown}); "
+                f"they would be lost: choose a new or empty folder{kept}"
+            )
 
     def _existing(self) -> set[Path]:
         if not self.directory.is_dir():
@@ -90,13 +100,6 @@ class OutputFolder:
             for p in self.directory.rglob("*")
             if p.is_file() and p.name != MANIFEST
         }
-
-    def _previous(self) -> set[Path]:
-        try:
-            data = json.loads((self.directory / MANIFEST).read_text(encoding="utf-8"))
-            return {Path(p) for p in data["files"]}
-        except (OSError, ValueError, KeyError, TypeError):
-            return set()
 
     def _writable(self) -> None:
         parent = self.directory.parent
@@ -127,10 +130,6 @@ class OutputFolder:
         """Where ``path`` (inside the output folder) is written during the run."""
         return self.staging / Path(path).resolve().relative_to(self.directory)
 
-    def final(self, path: Path) -> Path:
-        """Where a staged file ends up."""
-        return self.directory / Path(path).relative_to(self.staging)
-
     def commit(self) -> None:
         """Put the staged run in place of the output folder (module docs)."""
         files = sorted(
@@ -140,7 +139,13 @@ class OutputFolder:
         if self.manifest:
             text = json.dumps(manifest, indent=2) + "\n"
             (self.staging / MANIFEST).write_text(text, encoding="utf-8")
-        os.chmod(self.staging, 0o777 & ~_umask())
+        if self.directory.exists():  # files that appeared during the run are not lost either
+            kept, self.staging = self.staging, None  # not discarded: the run is kept
+            self._refuse_foreign(self._existing(), f"; this run is kept in {kept}")
+            self.staging = kept
+            shutil.copymode(self.directory, self.staging)
+        else:
+            os.chmod(self.staging, 0o777 & ~_umask())
         previous = None
         if self.directory.exists():
             previous = Path(
@@ -174,15 +179,17 @@ def listed(directory: Path) -> list[Path]:
         return []
 
 
-def add_to_manifest(directory: Path, files: Iterable[Path]) -> None:
-    """Add files written into a run's folder afterwards (``vares erect``) to its manifest."""
+def add_to_manifest(directory: Path, files: Iterable[Path], replacing: Path) -> None:
+    """List files written into a run's folder afterwards (``vares erect``) in its manifest, in
+    place of those it listed in the subfolder ``replacing`` (a rerun may write fewer)."""
     directory = Path(directory).resolve()
     path = directory / MANIFEST
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         data = {"vares_version": __version__, "files": []}
-    listed = set(data.get("files", []))
+    sub = Path(replacing).resolve().relative_to(directory)
+    listed = {f for f in data.get("files", []) if sub not in Path(f).parents}
     listed |= {str(Path(f).resolve().relative_to(directory)) for f in files}
     data["files"] = sorted(listed)
     text = json.dumps(data, indent=2) + "\n"

@@ -25,7 +25,10 @@ def batch(
             "cluster: scheduler address, e.g. tcp://10.0.0.5:8786.",
         ),
     ] = None,
-    force: Annotated[bool, typer.Option("--force", "-f", help="Rerun complete jobs too.")] = False,
+    force: Annotated[
+        bool,
+        typer.Option("--force", "-f", help="Rerun complete jobs too, replacing their runs."),
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Only the final table.")] = False,
 ) -> None:
     """Run many jobs in parallel; complete jobs are skipped, failing ones reported."""

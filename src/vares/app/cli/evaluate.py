@@ -7,10 +7,11 @@ import typer
 
 from ...analysis.evaluate import evaluate as evaluate_pattern
 from ...analysis.statistics import field_statistics
-from ...io.files import check_writable, write_json
+from ...io.files import write_json
 from ...io.meshes import read_mesh, read_pattern, write_surface
 from ...solver.options import SolveOptions
 from ..sections import MaterialOptions
+from ..staging import OutputFolder
 from .common import console, field_table, guarded
 from .flags import InputError, build, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
@@ -61,7 +62,8 @@ def evaluate(
         coordinates = read_pattern(pattern_file, mesh)
         output = values["output"]
         paths = [output / "evaluation.json", output / "evaluation.vtu"]
-        check_writable(paths, values["force"])
+        folder = OutputFolder(output, paths, force=values["force"], inputs=[surface, pattern_file])
+        folder.check()
         result = evaluate_pattern(
             mesh,
             coordinates,
@@ -85,8 +87,13 @@ def evaluate(
             "compressed_area_fraction": result.compressed_area_fraction,
             "fields": field_statistics(result.fields),
         }
-        write_surface(paths[1], mesh, coordinates, result.fields)
-        write_json(paths[0], data)
+        folder.start()
+        try:  # the two files as one set, as every run writes its files
+            write_surface(folder.staged(paths[1]), mesh, coordinates, result.fields)
+            write_json(folder.staged(paths[0]), data)
+            folder.commit()
+        finally:
+            folder.discard()
         if not values["quiet"]:
             console.print(field_table(result.fields))
             console.print(
