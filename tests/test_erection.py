@@ -203,6 +203,28 @@ def test_flat_panel_cut_too_small_carries_the_analytic_uniform_stress(cell_type)
     np.testing.assert_allclose(result.fields["state"], 0.0)
 
 
+def test_a_trial_point_whose_state_is_not_found_is_stepped_back_from(monkeypatch):
+    """The first trial of the line search raises (a wrinkled state not found there): the step
+    is shortened as at a fold and the erection still reaches the analytic solution."""
+    from vares.mechanics.wrinkling import WrinklingError
+
+    uv, mesh, to_3d = flat_panel()
+    pattern = jiggled(mesh, 0.9 * uv, 0.08)
+    evaluate, calls = ErectionProblem.evaluate, []
+
+    def once_unfound(self, x, order=2):
+        if order == 2:
+            calls.append(1)
+            if len(calls) == 2:  # the first trial point: the first call is at the start
+                raise WrinklingError("the wrinkled state was not found (injected)")
+        return evaluate(self, x, order)
+
+    monkeypatch.setattr(ErectionProblem, "evaluate", once_unfound)
+    result = vares.erect(Pattern(mesh, pattern), NeoHooke(E=1000.0, nu=0.3), 0.8, solver=TIGHT)
+    assert len(calls) > 2 and result.converged and result.iterations > 1
+    np.testing.assert_allclose(result.erected_points, to_3d(pattern / 0.9), atol=1e-10)
+
+
 def test_uniaxially_stretched_panel_wrinkles_with_the_uniaxial_force():
     """Pattern 0.95 × the design across, 1.05 × along: erected, the panel is stretched across
     and compressed along. Relaxed, it wrinkles everywhere and carries the uniaxial tension of

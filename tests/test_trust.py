@@ -245,3 +245,17 @@ def test_batch_jobs_whose_folders_nest_are_refused(tmp_path):
     result = run("batch", tmp_path / "a.toml", tmp_path / "b.toml")
     assert result.exit_code == 2 and "one into the other's" in error_line(result)
     assert not (tmp_path / "X").exists()
+
+
+def test_pseudo_time_reports_an_overlapping_pattern_without_restarting(monkeypatch):
+    """Pseudo-time starts from the projection; a pattern it ends with that overlaps itself is
+    reported as such (Tutte's embedding, which has no plane, is no restart for it)."""
+    from vares.geometry.injectivity import Overlap
+    from vares.solver import api
+
+    mesh = hypar(n=6)
+    crossing = Overlap(np.zeros(0, int), np.array([[0.0, 0.0]]), np.array([0]))
+    monkeypatch.setattr(api, "pattern_overlap", lambda mesh, x: crossing)
+    result = vares.solve(mesh, NEO_HOOKE, strategy="pseudo-time")
+    assert not result.converged and result.overlap is crossing
+    assert result.initial_guess == "projection"

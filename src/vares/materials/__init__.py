@@ -1,7 +1,14 @@
 """Hyperelastic laws on the invariants of the in-plane right Cauchy–Green tensor."""
 
 from .anisotropic import NonCrimpFabric, OrthotropicStVenantKirchhoff
-from .base import INVARIANTS, Fibres, Hyperelastic, MaterialError, MaterialResponse
+from .base import (
+    INVARIANTS,
+    Fibres,
+    Hyperelastic,
+    InadmissibleState,
+    MaterialError,
+    MaterialResponse,
+)
 from .isotropic import IncompressibleNeoHooke, NeoHooke, StVenantKirchhoff
 from .presets import FabricPreset, fabric, load_presets, presets
 
@@ -41,6 +48,7 @@ __all__ = [
     "FabricPreset",
     "Fibres",
     "Hyperelastic",
+    "InadmissibleState",
     "IncompressibleNeoHooke",
     "MaterialError",
     "MaterialResponse",

@@ -35,6 +35,11 @@ class MaterialError(ValueError):
     """Inadmissible material parameters or fibre directions."""
 
 
+class InadmissibleState(RuntimeError):
+    """A deformation at which the response cannot be evaluated (e.g. no wrinkled state is
+    found): a Newton step treats such a point like a fold, as infinite energy."""
+
+
 @dataclass(frozen=True)
 class Fibres:
     """Unit fibre directions in the pattern plane, ``(2,)`` each: ``warp`` Φ₁ and ``fill`` Φ₂."""

@@ -27,12 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.elements import ReferenceElement
-from ..materials import Fibres, Hyperelastic, MaterialError
+from ..materials import Fibres, Hyperelastic, InadmissibleState, MaterialError
 from .assembly import Connectivity
 from .forward import ReferenceBlock, forward_block, forward_projected_hessian, reference_block
 from .loads import cable_terms, pressure_terms
 from .problem import first_positive_root
-from .wrinkling import WrinklingError, relaxed_response
+from .wrinkling import relaxed_response
 
 __all__ = ["Cables", "ErectionEvaluation", "ErectionProblem", "MembraneBlock", "membrane_block"]
 
@@ -228,7 +228,7 @@ class ErectionProblem:
             return float("inf")
         try:
             return self.evaluate(x, order=0).energy
-        except WrinklingError:
+        except InadmissibleState:
             return float("inf")
 
     # ------------------------------------------------------------------ admissibility

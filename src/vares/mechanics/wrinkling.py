@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..materials import Fibres, Hyperelastic
+from ..materials import Fibres, Hyperelastic, InadmissibleState
 
 __all__ = [
     "SLACK",
@@ -68,7 +68,7 @@ _OFFSETS = np.pi * np.concatenate(
 )
 
 
-class WrinklingError(RuntimeError):
+class WrinklingError(InadmissibleState):
     """The wrinkled state of some point was not found."""
 
 

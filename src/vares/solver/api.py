@@ -119,9 +119,11 @@ def _solve(mesh, material, thickness, prestress, options, callback, given) -> Pa
     run = _Run(mesh, material, thickness, prestress, options, callback)
     start = initial_guess(mesh, options, given)
     attempt = run.attempt(start)
-    if attempt.overlap is not None and options.initial_guess == "auto" and start.kind != "tutte":
+    may_restart = options.initial_guess == "auto" and options.strategy != "pseudo-time"
+    if attempt.overlap is not None and may_restart and start.kind != "tutte":
         # a start that is not one-to-one can lead to a minimum whose outline laps over itself;
-        # Tutte's embedding starts on the right side of every fold
+        # Tutte's embedding starts on the right side of every fold (not for pseudo-time, whose
+        # steps start from a projection)
         retry = run.attempt(Start(tutte(mesh), "tutte", None), restart=True)
         if retry.reason is None or retry.energy < attempt.energy:
             attempt = retry

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..materials import InadmissibleState
 from ..mechanics.assembly import Assembler
 from .linear import LinearSolver, SingularMatrixError
 from .result import IterationRecord, StepRecord
@@ -191,7 +192,10 @@ def newton(
     squeezed = 0  # iterations in a row whose steps a fold held back, each shorter
     for iteration in range(ctx.max_iterations + 1):
         if evaluation is None:
-            evaluation = problem.evaluate(x, order=2)
+            try:
+                evaluation = problem.evaluate(x, order=2)
+            except InadmissibleState as exc:  # the next strategy may still get on from x
+                raise Failure(str(exc), x) from exc
         residual_vector = ctx.residual(ctx.assembler.vector(evaluation.gradients))
         residual = float(np.linalg.norm(residual_vector))
         initial_residual = residual if initial_residual is None else initial_residual
@@ -359,8 +363,11 @@ class _LineSearch:
                 elif problem.inverted_cells(trial).size:
                     energy = np.inf
                 else:
-                    at_trial = problem.evaluate(trial, order=2)
-                    energy = at_trial.energy
+                    try:
+                        at_trial = problem.evaluate(trial, order=2)
+                        energy = at_trial.energy
+                    except InadmissibleState:  # like a fold: shorter steps are tried
+                        energy = np.inf
                 if energy <= self.energy + 1e-4 * alpha * slope + ctx.energy_noise:
                     return trial, alpha, "projected" if self.projected else "exact", at_trial
                 alpha *= 0.5
