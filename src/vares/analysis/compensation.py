@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..solver.result import PatternResult
+from .statistics import stress_statistics
 
 __all__ = ["CompensationReport", "YarnReport", "compensation_report"]
 
@@ -71,21 +72,20 @@ class CompensationReport:
 
 def _yarn(fields, yarn: str, target: np.ndarray, thickness: float, threshold: float):
     weight = fields["surface_area"]
-    total = weight.sum()
     compensation = fields[f"{yarn}_compensation"]
     achieved = thickness * fields[f"{yarn}_stress"]
-    target = np.broadcast_to(target, achieved.shape)
+    forces = stress_statistics(achieved, np.broadcast_to(target, achieved.shape), weight)
     slack = achieved < threshold
     return YarnReport(
-        compensation_mean=float(compensation @ weight / total),
+        compensation_mean=float(compensation @ weight / weight.sum()),
         compensation_min=float(compensation.min()),
         compensation_max=float(compensation.max()),
-        target_mean=float(target @ weight / total),
-        achieved_mean=float(achieved @ weight / total),
-        achieved_min=float(achieved.min()),
-        achieved_max=float(achieved.max()),
-        rms_deviation=float(np.sqrt((achieved - target) ** 2 @ weight / total)),
-        slack_area_fraction=float(weight[slack].sum() / total),
+        target_mean=forces["intended"],
+        achieved_mean=forces["mean"],
+        achieved_min=forces["min"],
+        achieved_max=forces["max"],
+        rms_deviation=forces["rms_deviation"],
+        slack_area_fraction=float(weight[slack].sum() / weight.sum()),
         slack_cells=int(slack.sum()),
     )
 

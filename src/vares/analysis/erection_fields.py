@@ -17,14 +17,13 @@ from ..geometry.mesh import SurfaceMesh
 from ..mechanics.erection import ErectionProblem
 from ..mechanics.fields import COMPRESSION_TOLERANCE
 from ..mechanics.forward import forward_block
+from .statistics import stress_statistics
 
 __all__ = [
     "CELL_FIELDS",
-    "STATE_NAMES",
     "erection_statistics",
     "membrane_forces",
     "node_normals",
-    "stress_statistics",
 ]
 
 #: Per-cell results of an erection: name → (description, unit kind).
@@ -39,7 +38,6 @@ CELL_FIELDS: dict[str, tuple[str, str]] = {
     "det_F": ("area ratio erected/pattern", "1"),
     "surface_area": ("area of the cell on the design surface", "area"),
 }
-STATE_NAMES = ("taut", "wrinkled", "slack")
 
 
 def membrane_forces(
@@ -114,21 +112,6 @@ def node_normals(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
             np.add.at(lumped, cells[:, a], areas[mine] / cells.shape[1])
         start += len(cells)
     return normals / np.linalg.norm(normals, axis=1, keepdims=True), lumped
-
-
-def stress_statistics(
-    values: np.ndarray, intended: np.ndarray, area: np.ndarray
-) -> dict[str, float]:
-    """``mean``, ``min``, ``max``, ``intended`` (mean) and ``rms_deviation`` of one yarn's forces,
-    weighted by ``area``."""
-    total = area.sum()
-    return {
-        "mean": float(values @ area / total),
-        "min": float(values.min()),
-        "max": float(values.max()),
-        "intended": float(intended @ area / total),
-        "rms_deviation": float(np.sqrt((values - intended) ** 2 @ area / total)),
-    }
 
 
 def erection_statistics(

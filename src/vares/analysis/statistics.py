@@ -1,10 +1,11 @@
-"""Statistics of per-cell fields: minimum, maximum and area-weighted mean."""
+"""Statistics of per-cell fields: minimum, maximum, area-weighted mean, and a yarn force's
+deviation from its intended value."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["field_statistics"]
+__all__ = ["field_statistics", "stress_statistics"]
 
 
 def _statistics(values: np.ndarray, weights: np.ndarray) -> dict[str, float]:
@@ -25,4 +26,19 @@ def field_statistics(fields: dict[str, np.ndarray]) -> dict[str, dict[str, float
         name: _statistics(values, weights)
         for name, values in fields.items()
         if name not in ("pattern_area", "surface_area", "energy")
+    }
+
+
+def stress_statistics(
+    values: np.ndarray, intended: np.ndarray, area: np.ndarray
+) -> dict[str, float]:
+    """``mean``, ``min``, ``max``, ``intended`` (mean) and ``rms_deviation`` of one yarn's forces,
+    weighted by ``area``."""
+    total = area.sum()
+    return {
+        "mean": float(values @ area / total),
+        "min": float(values.min()),
+        "max": float(values.max()),
+        "intended": float(intended @ area / total),
+        "rms_deviation": float(np.sqrt((values - intended) ** 2 @ area / total)),
     }

@@ -27,7 +27,7 @@ from .flatten import projection_plane
 from .mesh import SurfaceMesh
 from .surface_lines import CuttingError, SurfaceLine, geodesic_lines, plane_sections
 
-__all__ = ["LAYOUTS", "LineFamily", "boundary_loops_3d", "geodesic_between_ends", "line_family"]
+__all__ = ["LAYOUTS", "LineFamily", "geodesic_between_ends", "line_family"]
 
 LAYOUTS = ("auto", "parallel", "radial")
 
@@ -136,29 +136,12 @@ def line_family(
     return LineFamily("radial", normal, np.array([0.0, 0.0, 1.0]), centre, span, closed)
 
 
-def boundary_loops_3d(mesh: SurfaceMesh) -> list[np.ndarray]:
-    """The boundary loops of a mesh as node index arrays."""
-    following = {int(a): int(b) for a, b in mesh.boundary_edges()}
-    loops, seen = [], set()
-    for start in sorted(following):
-        if start in seen:
-            continue
-        loop, node = [start], following[start]
-        seen.add(start)
-        while node != start:
-            loop.append(node)
-            seen.add(node)
-            node = following[node]
-        loops.append(np.array(loop))
-    return loops
-
-
 def _high_point(mesh: SurfaceMesh) -> tuple[np.ndarray, bool]:
     """A point of the vertical axis of radial strips, and whether the surface has a high point
     to run them from: a highest boundary loop that is a hole (its centroid), or a highest node
     inside the surface."""
     points = mesh.points
-    loops = boundary_loops_3d(mesh)
+    loops = mesh.boundary_loops()
     if len(loops) > 1:
         top = max(loops, key=lambda loop: points[loop, 2].mean())
         return points[top].mean(axis=0), True

@@ -92,7 +92,7 @@ class Assembler:
         target = np.where(kept, np.cumsum(kept) - 1, self.nnz)
         total = sum(c.shape[0] * (d * c.shape[1]) ** 2 for c in mesh.cells.values())
         self._position = np.empty(total, dtype=np.int64)
-        self._dofs = []
+        dofs = []
         entry_start = position_start = 0
         for cells in mesh.cells.values():
             m, nen = cells.shape
@@ -110,8 +110,8 @@ class Assembler:
                 self._position[position_start : position_start + m * d * d * nen * nen],
             )
             position_start += m * d * d * nen * nen
-            self._dofs.append((d * cells[:, :, None] + np.arange(d)).reshape(m, -1))
-        self._all_dofs = np.concatenate([d.ravel() for d in self._dofs])
+            dofs.append((d * cells[:, :, None] + np.arange(d)).reshape(m, -1))
+        self._all_dofs = np.concatenate([block.ravel() for block in dofs])
 
     def vector(self, gradients: list[np.ndarray]) -> np.ndarray:
         """Global gradient ``(n, d)`` from per-cell gradients ``(m, nen, d)`` of each block."""

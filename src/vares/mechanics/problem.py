@@ -168,13 +168,6 @@ class Problem:
             return float("inf")
         return self.evaluate(coordinates, order=0).energy
 
-    def jacobian_determinants(self, coordinates: np.ndarray) -> list[np.ndarray]:
-        """``det J`` of the pattern at each block's check points, ``(m, c)`` per block."""
-        return [
-            determinant(ELEMENTS[t].jacobians(coordinates, cells, at="check"))
-            for t, cells in self.mesh.cells.items()
-        ]
-
     def inverted_cells(self, coordinates: np.ndarray) -> np.ndarray:
         """Global ids of the cells with ``det J ≤ 0`` somewhere (inverted or collapsed)."""
         return inverted_cells(self.mesh, coordinates)

@@ -42,7 +42,6 @@ from ..materials import Fibres, Hyperelastic, InadmissibleState
 
 __all__ = [
     "SLACK",
-    "STATES",
     "TAUT",
     "WRINKLED",
     "RelaxedResponse",
@@ -52,7 +51,6 @@ __all__ = [
 
 #: Per-point states.
 TAUT, WRINKLED, SLACK = 0, 1, 2
-STATES = ("taut", "wrinkled", "slack")
 
 #: Stresses above −this × the law's stiffness count as non-negative (round-off of a stress-free
 #: state); stretches below 1 + this as not stretched.

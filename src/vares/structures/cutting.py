@@ -17,7 +17,6 @@ from typing import Any
 import numpy as np
 
 from ..geometry.cutting import CutMesh
-from ..geometry.line_families import boundary_loops_3d
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.outline import allowance_outline
 from ..geometry.surface_lines import min_angles, triangulated
@@ -25,10 +24,11 @@ from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
 from ..solver import IterationRecord, SolveOptions
 from ..units import unit_factor
-from .layout import StripPlan, plan_strips, strips_along_lines, width_across
+from .layout import StripPlan, plan_strips, strips_along_lines
 from .matching import StructureResult, solve_structure
 from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
+from .panels import width_across_warp
 
 __all__ = ["CutResult", "PieceOutline", "SeamLine", "cut"]
 
@@ -165,7 +165,7 @@ def cut(
         )
         outlines = piece_outlines(plan.cut, result, cutting, allowances)
         widths = [
-            width_across(o.cut, r.fibres.warp)
+            width_across_warp(o.cut, r.fibres.warp)
             for o, r in zip(outlines, result.results, strict=True)
         ]
         rounds.append(max(widths))
@@ -230,7 +230,7 @@ def piece_outlines(
     points = cut_mesh.mesh.points
     n = len(points)
     seam_keys = set((cut_mesh.seam_edges @ np.array([n, 1])).tolist())
-    loops = boundary_loops_3d(cut_mesh.mesh)
+    loops = cut_mesh.mesh.boundary_loops()
     high = set()
     if len(loops) > 1:
         high = set(max(loops, key=lambda loop: points[loop, 2].mean()).tolist())
@@ -238,7 +238,7 @@ def piece_outlines(
     outlines = []
     for index, result in enumerate(structure.results):
         used = np.unique(cells[cut_mesh.panel_ids == index])
-        ring_nodes = max(boundary_loops_3d(result.mesh), key=len)
+        ring_nodes = result.mesh.boundary_loops()[0]  # the longest
         global_nodes = used[ring_nodes]
         kinds = []
         for a, b in zip(global_nodes, np.roll(global_nodes, -1), strict=True):

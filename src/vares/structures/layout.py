@@ -26,7 +26,7 @@ from ..geometry.flatten import lscm
 from ..geometry.line_families import LineFamily, geodesic_between_ends, line_family
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
-from .panels import Panel, split_panels
+from .panels import Panel, split_panels, width_across_warp
 
 __all__ = ["SEAM_KINDS", "StripPlan", "pattern_direction", "plan_strips", "strips_along_lines"]
 
@@ -218,18 +218,13 @@ def pattern_direction(mesh: SurfaceMesh, coordinates: np.ndarray, direction) -> 
     return total / np.linalg.norm(total)
 
 
-def width_across(coordinates: np.ndarray, warp: np.ndarray) -> float:
-    """Extent of points ``(n, 2)`` across the 2D direction ``warp``."""
-    return float(np.ptp(coordinates @ np.array([-warp[1], warp[0]])))
-
-
 def _widths(plan: StripPlan, family, seam_allowance: float, edge_allowance: float) -> list[float]:
     """Flattened width of every strip with its two side allowances (module docs)."""
     out = []
     last = len(plan.panels) - 1
     for index, (panel, warp) in enumerate(zip(plan.panels, plan.warps, strict=True)):
         flat = lscm(panel.mesh)
-        width = width_across(flat, pattern_direction(panel.mesh, flat, warp))
+        width = width_across_warp(flat, pattern_direction(panel.mesh, flat, warp))
         outer = family is not None and not family.closed and index in (0, last)
         sides = 2 if last == 0 else 1
         allowance = (

@@ -49,10 +49,6 @@ class ReferenceElement:
     shape_gradients: np.ndarray
     check_gradients: np.ndarray
 
-    @property
-    def num_quadrature_points(self) -> int:
-        return len(self.quadrature_weights)
-
     def jacobians(self, coordinates: np.ndarray, cells: np.ndarray, at: str = "quadrature"):
         """``∂x/∂ξ`` of every cell, ``(m, q, d, 2)`` for node coordinates ``(n, d)``."""
         grads = self.shape_gradients if at == "quadrature" else self.check_gradients
