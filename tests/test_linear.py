@@ -121,6 +121,21 @@ def test_every_linear_solver_gives_the_same_pattern(name):
     )
 
 
+@pytest.mark.parametrize("name", available_solvers())
+def test_a_new_sparsity_pattern_of_the_same_size_is_analysed_again(name):
+    """Two definite matrices of one size and one number of entries, their off-diagonal pairs in
+    different places: a solver keeping its analysis per pattern solves both exactly."""
+    rhs = np.arange(1.0, 7.0)
+    solver = get_solver(name)
+    for pairs in (((0, 1), (2, 3)), ((0, 5), (1, 4))):
+        dense = 4.0 * np.eye(6)
+        for i, j in pairs:
+            dense[i, j] = dense[j, i] = 1.0
+        matrix = sp.csr_matrix(dense)
+        solver.factorize(matrix)
+        np.testing.assert_allclose(matrix @ solver.solve(rhs), rhs, rtol=0, atol=1e-12)
+
+
 def test_singular_matrices_are_reported():
     singular = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
     solver = get_solver("scipy-superlu")

@@ -193,14 +193,15 @@ class PardisoSolver:
         global _PARDISO_ANALYSED
         size = matrix.shape[0]
         if self._upper is None or not _same_pattern(self._upper[0], _pattern(matrix)):
-            self._upper = (_pattern(matrix), *_upper_triangle_map(matrix))
+            index, indptr, indices = _upper_triangle_map(matrix)
+            self._upper = (_pattern(matrix), index, indptr, indices)
+            self._ia = (indptr + 1).astype(np.int32)
+            self._ja = (indices + 1).astype(np.int32)
         _, index, indptr, indices = self._upper
         # PARDISO needs every diagonal entry stored, even a zero one (a bordered constraint):
         # the map's index -1 is such an added zero
         data = np.append(matrix.data, 0.0)[index]
         self._matrix = sp.csr_matrix((data, indices, indptr), shape=matrix.shape)
-        self._ia = (indptr + 1).astype(np.int32)
-        self._ja = (indices + 1).astype(np.int32)
         empty = np.zeros(size)
         if _PARDISO_ANALYSED is None or not _same_pattern(
             _PARDISO_ANALYSED, _pattern(self._matrix)
@@ -290,16 +291,16 @@ class CholmodSolver:
 
         self._cholmod = cholmod
         self._factor = None
-        self._pattern: tuple[int, int] | None = None
+        self._pattern: tuple | None = None
         self._fallback = fallback or SuperLUSolver()
         self._use_fallback = False
 
     def factorize(self, matrix: sp.csr_matrix) -> None:
         csc = matrix.tocsc()
-        pattern = (csc.shape[0], csc.nnz)
+        pattern = _pattern(csc)  # the analysis holds for this sparsity pattern only
         self._use_fallback = False
         try:
-            if self._factor is None or pattern != self._pattern:
+            if self._factor is None or not _same_pattern(self._pattern, pattern):
                 self._factor = self._cholmod.analyze(
                     csc, mode="supernodal", ordering_method="nesdis"
                 )
