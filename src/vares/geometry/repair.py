@@ -25,10 +25,10 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
-from scipy.spatial import cKDTree
 
 from .elements import ELEMENTS
 from .mesh import MeshError, _EdgeTable, _listing, corner_fans
+from .weld import coincident_nodes
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
 
@@ -133,7 +133,7 @@ def repair(
     counts = dict(triangulated_polygons=triangulated)
     if weld:
         tolerance = WELD_TOLERANCE * _median_edge(points, blocks)
-        mapping = _weld_map(points, tolerance)
+        mapping = coincident_nodes(points, tolerance)
         counts.update(welded_nodes=int(points.shape[0] - np.unique(mapping).size))
         counts.update(weld_tolerance=tolerance)
         blocks = {t: mapping[b] for t, b in blocks.items()}
@@ -165,21 +165,6 @@ def _median_edge(points: np.ndarray, blocks: dict[str, np.ndarray]) -> float:
     lengths = np.concatenate(lengths) if lengths else np.zeros(0)
     lengths = lengths[lengths > 0]
     return float(np.median(lengths)) if lengths.size else 0.0
-
-
-def _weld_map(points: np.ndarray, tolerance: float) -> np.ndarray:
-    """For every node, the node it is welded onto (the smallest index of its cluster)."""
-    if tolerance <= 0 or len(points) < 2:
-        return np.arange(len(points))
-    pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
-    if not len(pairs):
-        return np.arange(len(points))
-    n = len(points)
-    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
-    first = np.full(label.max() + 1, n)
-    np.minimum.at(first, label, np.arange(n))
-    return first[label]
 
 
 def _drop(blocks, owners, marked):

@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 
 from .mesh import MeshError, SurfaceMesh
 
-__all__ = ["Welded", "corner_nodes", "weld"]
+__all__ = ["Welded", "coincident_nodes", "corner_nodes", "weld"]
 
 
 class Welded:
@@ -33,6 +33,31 @@ class Welded:
         self.mesh = mesh
         self.node_maps = node_maps
         self.cell_ranges = cell_ranges
+
+
+def coincident_nodes(
+    points: np.ndarray,
+    tolerance: float,
+    candidates: np.ndarray | None = None,
+    apart: np.ndarray | None = None,
+) -> np.ndarray:
+    """For every node, the node it is merged with: the smallest index of its cluster of nodes
+    closer than ``tolerance`` to one another (chains join). Only ``candidates`` (indices; default
+    all) are merged, and nodes of one ``apart`` label (one per node) never directly."""
+    n = len(points)
+    index = np.arange(n) if candidates is None else np.asarray(candidates, dtype=np.int64)
+    if tolerance <= 0 or index.size < 2:
+        return np.arange(n)
+    pairs = index[cKDTree(points[index]).query_pairs(tolerance, output_type="ndarray")]
+    if apart is not None:
+        pairs = pairs[apart[pairs[:, 0]] != apart[pairs[:, 1]]]
+    if not len(pairs):
+        return np.arange(n)
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max() + 1, n)
+    np.minimum.at(first, label, np.arange(n))
+    return first[label]
 
 
 def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welded:
@@ -55,19 +80,10 @@ def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welde
     candidates = np.concatenate(
         [offset + np.unique(m.boundary_edges()) for m, offset in zip(meshes, offsets, strict=False)]
     )
-    pairs = cKDTree(points[candidates]).query_pairs(tolerance, output_type="ndarray")
-    pairs = candidates[pairs]
-    pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
-    n = len(points)
-    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
+    merged = coincident_nodes(points, tolerance, candidates, apart=owner)
     # welded node = first node of each group, numbered in order of first appearance
-    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
-    order = np.argsort(first)
-    renumber = np.empty_like(order)
-    renumber[order] = np.arange(len(order))
-    welded_of = renumber[inverse.ravel()]
-    welded_points = np.zeros((len(order), 3))
+    first, welded_of = np.unique(merged, return_inverse=True)
+    welded_points = np.zeros((len(first), 3))
     counts = np.bincount(welded_of)
     for axis in range(3):
         welded_points[:, axis] = np.bincount(welded_of, weights=points[:, axis]) / counts
@@ -85,8 +101,6 @@ def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welde
         mesh = SurfaceMesh(welded_points, {t: np.vstack(b) for t, b in blocks.items()})
     except MeshError as exc:
         raise MeshError(f"the welded panels are not one valid surface: {exc}") from None
-    if mesh.num_points != len(welded_points):
-        raise MeshError("the welded panels left nodes without cells")
     return Welded(mesh, node_maps, cell_ranges)
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.mesh import MeshError, SurfaceMesh
+from ..geometry.weld import coincident_nodes
 
 __all__ = ["NamedMesh", "read_3dm", "unit_system", "write_3dm"]
 
@@ -59,9 +60,7 @@ def _weld(parts: list[tuple[np.ndarray, dict[str, np.ndarray]]]):
     """Join meshes, merging coincident vertices (render meshes of adjacent Brep faces)."""
     points = np.vstack([p for p, _ in parts])
     scale = float(np.ptp(points, axis=0).max()) or 1.0
-    keys = np.round(points / (1e-9 * scale)).astype(np.int64)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.ravel()
+    first, inverse = np.unique(coincident_nodes(points, 1e-9 * scale), return_inverse=True)
     cells: dict[str, list[np.ndarray]] = {}
     offset = 0
     for part_points, part_cells in parts:
