@@ -18,7 +18,7 @@ import numpy as np
 
 from .cutting import cut_mesh
 from .mesh import SurfaceMesh
-from .surface_lines import CuttingError, SurfaceLine, check_triangles, locate_on_edges, mesh_edges
+from .surface_lines import CuttingError, EdgeLocator, SurfaceLine, check_triangles
 
 __all__ = ["closest_points", "curves_on_surface"]
 
@@ -30,8 +30,8 @@ def curves_on_surface(
     curves' points as nodes, and the lines on it."""
     import potpourri3d as pp3d
 
-    triangles = check_triangles(mesh)
-    edges, _ = mesh_edges(triangles)
+    check_triangles(mesh)  # triangles only
+    edges = mesh.edges()
     spacing = 0.5 * float(np.linalg.norm(np.diff(mesh.points[edges], axis=1), axis=2).mean())
     size = float(np.ptp(mesh.points, axis=0).max())
     located = []
@@ -47,6 +47,7 @@ def curves_on_surface(
         located.append((faces[keep], bary[keep]))
     base, chains = _insert(mesh, located, snap)
     solver = pp3d.EdgeFlipGeodesicSolver(base.points, base.cells["triangle"])
+    locate = EdgeLocator(base)
     lines = []
     for chain in chains:  # geodesic from point to point: the line passes through every one
         pieces = [
@@ -54,7 +55,7 @@ def curves_on_surface(
             for a, b in itertools.pairwise(chain)
         ]
         path = np.vstack([pieces[0]] + [p[1:] for p in pieces[1:]])
-        lines.append(locate_on_edges(base, path))
+        lines.append(locate.line(path))
     return base, lines
 
 

@@ -23,9 +23,9 @@ from .mesh import MeshError, SurfaceMesh
 
 __all__ = [
     "CuttingError",
+    "EdgeLocator",
     "SurfaceLine",
     "geodesic_lines",
-    "locate_on_edges",
     "mesh_edges",
     "plane_sections",
     "triangulated",
@@ -110,37 +110,42 @@ def mesh_edges(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return edges, index.reshape(-1, 3)
 
 
-def locate_on_edges(
-    mesh: SurfaceMesh, points: np.ndarray, tolerance: float | None = None
-) -> SurfaceLine:
-    """The :class:`SurfaceLine` through ``points`` ``(k, 3)`` that lie on edges or nodes of a
-    triangle mesh (as the points of a geodesic path do), within ``tolerance`` (default 1e-9 ×
-    the mesh size)."""
-    from scipy.spatial import cKDTree
+class EdgeLocator:
+    """Finds the edges and nodes of a triangle mesh that points lie on: the search trees are
+    built once per mesh (0.1 s on 20k triangles), then :meth:`line` for every line."""
 
-    nodes = mesh.points
-    size = float(np.ptp(nodes, axis=0).max()) or 1.0
-    tolerance = 1e-9 * size if tolerance is None else tolerance
-    edges, _ = mesh_edges(mesh.cells["triangle"])
-    a, b = nodes[edges[:, 0]], nodes[edges[:, 1]]
-    node_distance, nearest_node = cKDTree(nodes).query(points)
-    edge_tree = cKDTree(0.5 * (a + b))
-    ends, fractions = [], []
-    for point, distance, node in zip(points, node_distance, nearest_node, strict=True):
-        if distance <= tolerance:
-            ends.append((node, node))
-            fractions.append(0.0)
-            continue
-        _, candidates = edge_tree.query(point, k=min(16, len(edges)))
-        best, t = _nearest_edge(point, a[candidates], b[candidates])
-        if best[1] > tolerance:  # rare: search every edge
-            best, t = _nearest_edge(point, a, b)
-            candidates = np.arange(len(edges))
-        if best[1] > tolerance:
-            raise CuttingError(f"point {point} of a line does not lie on the mesh's edges")
-        ends.append(tuple(edges[candidates[best[0]]]))
-        fractions.append(t[best[0]])
-    return SurfaceLine.at(nodes, np.array(ends), np.array(fractions))
+    def __init__(self, mesh: SurfaceMesh, tolerance: float | None = None) -> None:
+        from scipy.spatial import cKDTree
+
+        self.nodes = mesh.points
+        size = float(np.ptp(self.nodes, axis=0).max()) or 1.0
+        self.tolerance = 1e-9 * size if tolerance is None else tolerance
+        self.edges = np.sort(mesh.edges(), axis=1)  # smaller node first
+        self.a, self.b = self.nodes[self.edges[:, 0]], self.nodes[self.edges[:, 1]]
+        self.node_tree = cKDTree(self.nodes)
+        self.edge_tree = cKDTree(0.5 * (self.a + self.b))
+
+    def line(self, points: np.ndarray) -> SurfaceLine:
+        """The :class:`SurfaceLine` through ``points`` ``(k, 3)``."""
+        nodes, edges, a, b, tolerance = self.nodes, self.edges, self.a, self.b, self.tolerance
+        node_distance, nearest_node = self.node_tree.query(points)
+        edge_tree = self.edge_tree
+        ends, fractions = [], []
+        for point, distance, node in zip(points, node_distance, nearest_node, strict=True):
+            if distance <= tolerance:
+                ends.append((node, node))
+                fractions.append(0.0)
+                continue
+            _, candidates = edge_tree.query(point, k=min(16, len(edges)))
+            best, t = _nearest_edge(point, a[candidates], b[candidates])
+            if best[1] > tolerance:  # rare: search every edge
+                best, t = _nearest_edge(point, a, b)
+                candidates = np.arange(len(edges))
+            if best[1] > tolerance:
+                raise CuttingError(f"point {point} of a line does not lie on the mesh's edges")
+            ends.append(tuple(edges[candidates[best[0]]]))
+            fractions.append(t[best[0]])
+        return SurfaceLine.at(nodes, np.array(ends), np.array(fractions))
 
 
 def _nearest_edge(point, a, b) -> tuple[tuple[int, float], np.ndarray]:
@@ -222,12 +227,13 @@ def geodesic_lines(mesh: SurfaceMesh, node_pairs: Sequence[tuple[int, int]]) -> 
     import potpourri3d as pp3d
 
     solver = pp3d.EdgeFlipGeodesicSolver(mesh.points, mesh.cells["triangle"])
+    locate = EdgeLocator(mesh)
     lines = []
     for start, end in node_pairs:
         if start == end:
             raise CuttingError("a geodesic needs two different end nodes")
         path = np.asarray(solver.find_geodesic_path(int(start), int(end)))
-        lines.append(locate_on_edges(mesh, path))
+        lines.append(locate.line(path))
     return lines
 
 
