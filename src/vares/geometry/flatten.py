@@ -239,7 +239,7 @@ def _projected_area_ratios(mesh: SurfaceMesh, plane: ProjectionPlane):
     return np.concatenate(ratios), np.concatenate(areas)
 
 
-def tutte(mesh: SurfaceMesh) -> np.ndarray:
+def tutte(mesh: SurfaceMesh, conformal: np.ndarray | None = None) -> np.ndarray:
     """Tutte's embedding with mean-value weights (Floater 2003): one-to-one on any disk-like
     triangle mesh, whatever its shape. Returns pattern coordinates ``(n, 2)``.
 
@@ -249,6 +249,7 @@ def tutte(mesh: SurfaceMesh) -> np.ndarray:
     closed for the solve by a node at their centre joined to the hole's boundary. The result
     keeps the cells' orientation and is scaled to the 3D area. Quads are split along a diagonal
     for the weights; a strongly non-convex quad may still fold (it is checked by the caller).
+    ``conformal``: the conformal map (:func:`lscm`) if the caller has it already.
     """
     import scipy.sparse as sp
     from scipy.sparse.linalg import spsolve
@@ -260,7 +261,7 @@ def tutte(mesh: SurfaceMesh) -> np.ndarray:
     rows, cols, weights = _mean_value_weights(points, triangles)
     laplacian = sp.csr_matrix((weights, (rows, cols)), shape=(n, n))
     laplacian = sp.diags(np.asarray(laplacian.sum(axis=1)).ravel()) - laplacian
-    boundary_xy = _ellipse(mesh, outer)
+    boundary_xy = _ellipse(mesh, outer, conformal)
     inner = np.setdiff1d(np.arange(n), outer)
     rhs = -laplacian[inner][:, outer] @ boundary_xy
     coordinates = np.empty((n, 2))
@@ -373,13 +374,13 @@ def _mean_value_weights(points, triangles):
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(values)
 
 
-def _ellipse(mesh: SurfaceMesh, outer: np.ndarray) -> np.ndarray:
+def _ellipse(mesh: SurfaceMesh, outer: np.ndarray, conformal: np.ndarray | None) -> np.ndarray:
     """Positions of the outer loop's nodes on an ellipse with the conformal boundary's axes."""
     ring = mesh.points[np.append(outer, outer[0])]
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
     angle = 2 * np.pi * arc[:-1] / arc[-1]
     try:
-        shape = lscm(mesh)[outer]
+        shape = (lscm(mesh) if conformal is None else conformal)[outer]
     except (ValueError, RuntimeError):
         shape = mesh.points[outer][:, :2]
     centred = shape - shape.mean(axis=0)

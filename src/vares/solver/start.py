@@ -75,9 +75,10 @@ def initial_guess(
         order = ["projection"]
     elif steep and not options.named_plane:
         order = ["lscm", "tutte"]
-    folded = []
+    folded, conformal = [], None
     for kind in order:
-        start = _make(mesh, kind, plane)
+        start = _make(mesh, kind, plane, conformal)
+        conformal = start.coordinates if kind == "lscm" else conformal
         inverted = inverted_cells(mesh, start.coordinates)
         if inverted.size and kind == "projection" and inverted.size <= MEND_AT_MOST:
             mended = untangle(mesh, start.coordinates)
@@ -94,12 +95,13 @@ def initial_guess(
     return _make(mesh, order[0], plane)
 
 
-def _make(mesh: SurfaceMesh, kind: str, plane: ProjectionPlane) -> Start:
+def _make(mesh: SurfaceMesh, kind: str, plane: ProjectionPlane, conformal=None) -> Start:
+    """A start of the given kind (Tutte's reuses the ``conformal`` map when it was made)."""
     if kind == "projection":
         return Start(plane.project(mesh.points), "projection", plane)
     if kind == "lscm":
         return Start(lscm(mesh), "lscm", None)
-    return Start(tutte(mesh), "tutte", None)
+    return Start(tutte(mesh, conformal), "tutte", None)
 
 
 def _given(mesh: SurfaceMesh, options: SolveOptions, given: np.ndarray) -> Start:
