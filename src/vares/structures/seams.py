@@ -7,7 +7,6 @@ and :func:`seam_marks` puts match marks at the same arc lengths on both sides.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -79,17 +78,21 @@ def find_seams(panels: list[Panel], tolerance: float | None = None) -> list[Seam
     size = float(np.ptp(all_points, axis=0).max()) or 1.0
     tolerance = 1e-6 * size if tolerance is None else tolerance
     boundary = [p.mesh.boundary_edges() for p in panels]
+    # one search over every panel's boundary nodes: the coinciding pairs of two panels
+    offsets = np.cumsum([0] + [p.mesh.num_points for p in panels])
+    owner = np.repeat(np.arange(len(panels)), np.diff(offsets))
+    candidates = np.concatenate([offsets[k] + np.unique(b) for k, b in enumerate(boundary)])
+    pairs = candidates[
+        cKDTree(all_points[candidates]).query_pairs(tolerance, output_type="ndarray")
+    ]
+    pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
+    pairs = np.where((owner[pairs[:, 0]] > owner[pairs[:, 1]])[:, None], pairs[:, ::-1], pairs)
+    matches: dict[tuple[int, int], dict[int, int]] = {}
+    for a, b in pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))].tolist():
+        i, j = int(owner[a]), int(owner[b])
+        matches.setdefault((i, j), {}).setdefault(a - int(offsets[i]), b - int(offsets[j]))
     seams = []
-    for i, j in itertools.combinations(range(len(panels)), 2):
-        nodes_i = np.unique(boundary[i])
-        nodes_j = np.unique(boundary[j])
-        tree = cKDTree(panels[j].mesh.points[nodes_j])
-        distance, index = tree.query(panels[i].mesh.points[nodes_i], distance_upper_bound=tolerance)
-        match = {
-            int(a): int(nodes_j[k])
-            for a, d, k in zip(nodes_i, distance, index, strict=True)
-            if np.isfinite(d)
-        }
+    for (i, j), match in sorted(matches.items()):
         if len(match) < 2:
             continue
         edges_j = {(int(a), int(b)) for a, b in boundary[j]}
