@@ -63,8 +63,16 @@ def test_cut_command_writes_the_plan_the_patterns_and_the_nest(tmp_path, small_s
     for a, b in itertools.combinations(cut_lines, 2):
         assert not a.intersects(b)  # no overlap on the roll (mm)
     assert max(p.bounds[3] for p in cut_lines) <= 1800 and min(p.bounds[1] for p in cut_lines) >= 0
+    # the yield from the drawing: the net (seam-line) areas over the roll area used
+    net = sum(Polygon(np.array(e.get_points("xy"))).area for e in seams_drawn) / 1000**2
+    assert nesting["yield"] == pytest.approx(net / (1.8 * nesting["length"]), rel=1e-6)
     names = {e.dxf.text for e in space.query("TEXT[layer=='MARKS']")}
     assert names and all(n.startswith("S") for n in names)
+    for k, panel in enumerate(panels, start=1):  # each width from the strip's own cut line
+        strip = ezdxf.readfile(out / f"strip-{k}" / "pattern.dxf").modelspace()
+        ring = np.array(next(iter(strip.query("LWPOLYLINE[layer=='CUT']"))).get_points("xy"))
+        across = np.array([-panel["warp"][1], panel["warp"][0]])
+        assert np.ptp(ring @ across) / 1000 == pytest.approx(panel["width"], rel=1e-6)
     panel_ids = meshio.read(out / "panels.vtu").cell_data["panel"][0]
     assert len(np.unique(panel_ids)) == len(panels)
     for name in ("cut_lines.png", "nest.png", "nest.svg", "strip-1/pattern.dxf"):

@@ -55,17 +55,25 @@ def test_lines_behind_a_cell_are_not_seen():
 
 
 def test_surface_view_draws_the_cells_it_sees():
-    """A view of a hypar seen from above shows every cell, and coloured cells in the image carry
-    the field's colours (shaded, so no brighter than the colour map's)."""
+    """A hypar seen from above: every cell shows, and every pixel has its cell's colour from the
+    colour map, shaded by how squarely the cell faces the viewer (between 0.55 and 1 of it)."""
+    from matplotlib import colormaps
+
     mesh = hypar(n=10)
     values = np.linspace(0.0, 1.0, mesh.num_cells)
-    fig = plot_surface(mesh, values, field="energy", view=View(elevation=89.0))
-    rgba = fig.axes[0].images[0].get_array()
-    assert rgba.shape[2] == 4 and rgba[..., 3].max() == 1.0
+    view = View(elevation=89.0)
+    fig = plot_surface(mesh, values, field="energy", view=view)
+    rgba = np.asarray(fig.axes[0].images[0].get_array())
     assert fig.axes[1].get_ylabel() == "strain energy"  # the colour bar
     plt.close(fig)
-    image = rasterise(mesh.cells, *View(elevation=89.0).project(mesh.points))
-    assert set(np.unique(image.index[image.index >= 0])) == set(range(mesh.num_cells))
+    image = rasterise(mesh.cells, *view.project(mesh.points))  # the same drawing's cells
+    shown = image.index >= 0
+    assert set(np.unique(image.index[shown])) == set(range(mesh.num_cells))
+    assert np.all(rgba[~shown, 3] == 0) and np.all(rgba[shown, 3] == 1)
+    expected = colormaps["viridis"](values)[image.index[shown], :3]  # energy: 0 … 1, viridis
+    ratio = rgba[shown, :3] / expected
+    assert np.all(ratio >= 0.55 - 1e-12) and np.all(ratio <= 1 + 1e-12)
+    assert np.ptp(ratio, axis=1).max() < 1e-12  # one shade per pixel: the colour's own hue
 
 
 def test_a_drawing_no_pixel_centre_falls_in_is_empty_not_an_error():

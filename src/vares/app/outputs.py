@@ -130,7 +130,10 @@ def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | No
         _write(panel, "surface.obj", lambda p: write_surface(p, panel.mesh, units=panel.units))
     if result.converged or result.overlap is not None:
         dxf = result.converged or job.output.allow_overlap
-        _write_pattern_files(panel, job, outcome.material.stiffness_scale, marks, dxf)
+        cut = None  # a strip of a cut job: its cut line with the allowance of every edge
+        if outcome.cut is not None:
+            cut = outcome.cut.outlines[outcome.panels.index(panel)].cut
+        _write_pattern_files(panel, job, outcome.material.stiffness_scale, marks, dxf, cut)
     data = summary(
         result, name=panel.name, input=job.input.to_dict(), tolerance=result.options.tolerance
     )
@@ -164,7 +167,12 @@ def _write(panel: PanelOutcome, name: str, writer: Callable[[Path], None]) -> No
 
 
 def _write_pattern_files(
-    panel: PanelOutcome, job: Job, material_scale: float, marks: np.ndarray | None, dxf: bool
+    panel: PanelOutcome,
+    job: Job,
+    material_scale: float,
+    marks: np.ndarray | None,
+    dxf: bool,
+    cut: np.ndarray | None,
 ) -> None:
     result, mesh = panel.result, panel.mesh
     x = result.material_coordinates
@@ -178,18 +186,20 @@ def _write_pattern_files(
         lambda p: write_surface(p, mesh, fields=result.fields, units=panel.units),
     )
     if dxf:
-        _write_dxf(panel, job, marks)
+        _write_dxf(panel, job, marks, cut)
     _write_drawings(panel, job, material_scale)
 
 
-def _write_dxf(panel: PanelOutcome, job: Job, marks: np.ndarray | None) -> None:
+def _write_dxf(
+    panel: PanelOutcome, job: Job, marks: np.ndarray | None, cut: np.ndarray | None
+) -> None:
     result, mesh, output = panel.result, panel.mesh, job.output
     x = result.material_coordinates
     spacing = output.mark_spacing
     if marks is not None and spacing is None:
         spacing = STRUCTURE_MARK_SPACING
     piece = CutPiece(
-        panel.name, mesh, x, warp=result.fibres.warp, label=_label(panel, job), marks=marks
+        panel.name, mesh, x, result.fibres.warp, _label(panel, job), marks=marks, cut=cut
     )
     _write(
         panel,

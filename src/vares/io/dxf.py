@@ -41,8 +41,10 @@ LAYERS = {"SEAM": 7, "CUT": 1, "WARP": 5, "MARKS": 3, "LABEL": 2}
 @dataclass
 class CutPiece:
     """One pattern to draw: coordinates ``(n, 2)`` in model units, warp direction ``(2,)``,
-    label lines, and optionally match mark positions (model units, ``(k, 2)``, on the seam
-    line) that replace the regularly spaced ones."""
+    label lines, optionally match mark positions (model units, ``(k, 2)``, on the seam line)
+    that replace the regularly spaced ones, and optionally its cut line (a ring ``(k, 2)`` in
+    model units, e.g. with an allowance per edge) that replaces the seam line grown by the
+    drawing's allowance."""
 
     name: str
     mesh: SurfaceMesh
@@ -50,6 +52,7 @@ class CutPiece:
     warp: np.ndarray | None = None
     label: Sequence[str] = ()
     marks: np.ndarray | None = field(default=None, repr=False)
+    cut: np.ndarray | None = field(default=None, repr=False)
 
 
 def _signed_area(ring: np.ndarray) -> float:
@@ -130,7 +133,10 @@ def write_dxf(
     for piece in pieces:
         coordinates = np.asarray(piece.coordinates, dtype=float) * factor
         seams = [coordinates[loop] for loop in piece.mesh.boundary_loops()]
-        cuts = cut_outline(seams, allowance)
+        if piece.cut is not None:
+            cuts = [np.asarray(piece.cut, dtype=float) * factor]
+        else:
+            cuts = cut_outline(seams, allowance)
         everything = np.vstack(cuts + seams)
         low, high = everything.min(axis=0), everything.max(axis=0)
         size = float(np.max(high - low))
