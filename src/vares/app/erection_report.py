@@ -14,7 +14,7 @@ import numpy as np
 
 from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path
-from .html_parts import figure, number, page, status_text, table
+from .html_parts import figure, number, page, picture, status_text, table
 
 __all__ = ["erection_section", "write_erection_report"]
 
@@ -62,7 +62,8 @@ def _comparison_rows(result: ErectionResult, units: str) -> list[tuple[str, str,
     return rows
 
 
-def _figures(result: ErectionResult, units: str) -> list[str]:
+def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[str]:
+    """The section's pictures; those the erection wrote into ``pictures`` are embedded."""
     from ..io.plot import plot_surface
 
     erected = result.erected_mesh
@@ -70,26 +71,22 @@ def _figures(result: ErectionResult, units: str) -> list[str]:
     per_cell = np.concatenate(
         [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
     )
-    drawings = [
-        (erected, per_cell, "normal_deviation", f"normal deviation from the design ({units})"),
-        (
-            result.mesh,
-            result.design_fields["warp_stress"],
-            "warp_stress",
-            "warp force on the design shape",
-        ),
-        (erected, result.fields["warp_stress"], "warp_stress", "warp force after erection"),
-        (
-            result.mesh,
-            result.design_fields["fill_stress"],
-            "fill_stress",
-            "fill force on the design shape",
-        ),
-        (erected, result.fields["fill_stress"], "fill_stress", "fill force after erection"),
-        (erected, result.fields["state"], "state", "taut (0) / wrinkled (1) / slack (2)"),
-    ]
+    design, after = result.design_fields, result.fields
+    drawings = [  # the file an erection writes of the same picture, if it writes one
+        ("deviation.png", erected, per_cell, "normal_deviation", "normal deviation from design"),
+        (None, result.mesh, design["warp_stress"], "warp_stress", "warp force on the design shape"),
+        ("warp_stress.png", erected, after["warp_stress"], "warp_stress", "warp force, erected"),
+        (None, result.mesh, design["fill_stress"], "fill_stress", "fill force on the design shape"),
+        ("fill_stress.png", erected, after["fill_stress"], "fill_stress", "fill force, erected"),
+        ("state.png", erected, after["state"], "state", "taut (0) / wrinkled (1) / slack (2)"),
+    ]  # fmt: skip
     out = []
-    for k, (mesh, values, field, caption) in enumerate(drawings):
+    for k, (name, mesh, values, field, caption) in enumerate(drawings):
+        if name == "deviation.png":
+            caption = f"{caption} ({units})"
+        if pictures is not None and name is not None and (pictures / name).is_file():
+            out.append(picture(pictures / name, caption, f"figure-erection-{k}"))
+            continue
         drawing = plot_surface(
             mesh,
             values,
@@ -102,8 +99,9 @@ def _figures(result: ErectionResult, units: str) -> list[str]:
     return out
 
 
-def erection_section(result: ErectionResult, units: str) -> list[str]:
-    """The section: status, comparison table (force per length), figures."""
+def erection_section(result: ErectionResult, units: str, pictures: Path | None = None) -> list[str]:
+    """The section: status, comparison table (force per length), figures (those in
+    ``pictures``, the erection's folder, embedded as they are)."""
     key = [
         ("status", "converged" if result.converged else f"not converged: {result.reason}"),
         ("panels welded", len(result.panels)),
@@ -138,7 +136,7 @@ def erection_section(result: ErectionResult, units: str) -> list[str]:
                 header=("", "on the design shape", "after erection"),
                 ident="erection-comparison",
             ),
-            *_figures(result, units),
+            *_figures(result, units, pictures),
         ]
     return parts
 
@@ -151,7 +149,7 @@ def write_erection_report(result: ErectionResult, directory: Path, units: str) -
         status_text(result.converged, result.reason),
         [],
     )
-    parts += [*erection_section(result, units), "</body></html>"]
+    parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
     path = Path(directory) / "report.html"
     with atomic_path(path) as temporary:
         temporary.write_text("\n".join(parts), encoding="utf-8")

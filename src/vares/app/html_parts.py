@@ -6,10 +6,11 @@ import base64
 import datetime
 import html
 import io
+from pathlib import Path
 
 from .._version import __version__
 
-__all__ = ["STYLE", "figure", "number", "page", "status_text", "table"]
+__all__ = ["STYLE", "figure", "number", "page", "picture", "status_text", "table"]
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
@@ -36,9 +37,19 @@ def _png(fig) -> str:
 
 
 def figure(fig, caption: str, ident: str) -> str:
+    """A matplotlib figure, drawn and embedded (and closed)."""
+    return _embedded(_png(fig), caption, ident)
+
+
+def picture(path: Path, caption: str, ident: str) -> str:
+    """A PNG file the run has written already, embedded (not drawn again)."""
+    return _embedded(base64.b64encode(Path(path).read_bytes()).decode("ascii"), caption, ident)
+
+
+def _embedded(png: str, caption: str, ident: str) -> str:
     return (
         f'<figure id="{ident}"><img alt="{html.escape(caption)}" '
-        f'src="data:image/png;base64,{_png(fig)}"><figcaption>{html.escape(caption)}'
+        f'src="data:image/png;base64,{png}"><figcaption>{html.escape(caption)}'
         "</figcaption></figure>"
     )
 

@@ -23,7 +23,7 @@ from ..materials import Hyperelastic
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
 from ..solver.linear import solver_choice
 from .erection_report import erection_section
-from .html_parts import figure, number, page, status_text, table
+from .html_parts import figure, number, page, picture, status_text, table
 from .job import Job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import units_of
@@ -161,9 +161,12 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
     caption = "the pattern with warp and fill"
     if crossings is not None:
         caption += f"; circled: where its outline crosses itself ({len(crossings)})"
+    preview = outcome.directory / "pattern.png"  # the same picture, written already
     parts = [
         "<h2>Pattern</h2>",
-        figure(
+        picture(preview, caption, "figure-pattern")
+        if preview.is_file()
+        else figure(
             plot_pattern(mesh, x, fibres=result.fibres, title="pattern", marks=crossings),
             caption,
             "figure-pattern",
@@ -204,7 +207,7 @@ def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
     if result.converged or result.overlap is not None:
         parts += _pattern_figures(panel, material)
     if outcome.erection is not None and outcome.structure is None:
-        parts += erection_section(outcome.erection, outcome.units)
+        parts += erection_section(outcome.erection, outcome.units, outcome.directory / "erect")
     files = [(f.name, os.path.relpath(f, panel.directory)) for f in panel.files]
     parts += [
         "<h2>Files</h2>",
