@@ -120,3 +120,18 @@ def test_translation_invariance_of_the_residual(mixed_mesh):
     np.testing.assert_allclose(force.sum(axis=0), 0.0, atol=1e-13)
     moment = np.sum(pattern[:, 0] * force[:, 1] - pattern[:, 1] * force[:, 0])
     assert abs(moment) < 1e-13
+
+
+def test_principal_values_keep_their_digits_where_they_are_close():
+    """Principal stresses 1 and 1 + 1e-10 of a rotated S C: their difference to 1e-5 (the trace
+    and determinant formula lost it to round-off), and an unsymmetric S C with a real spectrum."""
+    from vares.mechanics.fields import principal_values
+
+    angle = 0.3
+    r = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    close = r @ np.diag([1.0, 1.0 + 1e-10]) @ r.T
+    larger, smaller = principal_values(close)
+    assert larger - smaller == pytest.approx(1e-10, rel=1e-5)
+    S, C = np.array([[2.0, 0.3], [0.3, 1.0]]), np.array([[1.2, 0.1], [0.1, 0.9]])
+    expected = np.sort(np.linalg.eigvals(S @ C).real)[::-1]
+    np.testing.assert_allclose(principal_values(S @ C), expected, rtol=1e-14)

@@ -15,7 +15,7 @@ import numpy as np
 from ..geometry.elements import determinant
 from ..geometry.mesh import SurfaceMesh
 from ..mechanics.erection import ErectionProblem
-from ..mechanics.fields import COMPRESSION_TOLERANCE
+from ..mechanics.fields import COMPRESSION_TOLERANCE, principal_values, stress_along
 from ..mechanics.forward import forward_block
 from .statistics import stress_statistics
 
@@ -70,17 +70,14 @@ def membrane_forces(
         warp = (1.0, 0.0) if fibres is None else fibres.warp
         fill = (0.0, 1.0) if fibres is None else fibres.fill
         CSC = C @ S @ C
+        larger, smaller = principal_values(S @ C)
         values = {
-            "warp_stress": _along(CSC, C, warp) / det_f,
-            "fill_stress": _along(CSC, C, fill) / det_f,
+            "warp_stress": stress_along(CSC, C, warp) / det_f,
+            "fill_stress": stress_along(CSC, C, fill) / det_f,
             "det_F": det_f,
+            "stress_max": larger / det_f,
+            "stress_min": smaller / det_f,
         }
-        SC = S @ C  # its eigenvalues are real: it is similar to the symmetric C½ S C½
-        half = 0.5 * (SC[..., 0, 0] + SC[..., 1, 1])
-        difference = 0.5 * (SC[..., 0, 0] - SC[..., 1, 1])
-        # (not √(half² − det): that loses half the digits where the eigenvalues are close)
-        root = np.sqrt(np.maximum(difference**2 + SC[..., 0, 1] * SC[..., 1, 0], 0.0))
-        values["stress_max"], values["stress_min"] = (half + root) / det_f, (half - root) / det_f
         for name, value in values.items():
             scale = 1.0 if name == "det_F" else t
             out[name][ids] = scale * np.sum(weights * value, axis=1) / weights.sum(axis=1)
@@ -89,12 +86,6 @@ def membrane_forces(
         out["stress_min"] > tolerance, 0.0, np.where(out["stress_max"] > tolerance, 1.0, 2.0)
     )
     return out
-
-
-def _along(CSC: np.ndarray, C: np.ndarray, phi) -> np.ndarray:
-    """``Φ·CSCΦ / Φ·CΦ``: the Cauchy stress along the erected ``FΦ``, times ``det F``."""
-    phi = np.asarray(phi, dtype=float)
-    return np.einsum("a,...ab,b->...", phi, CSC, phi) / np.einsum("a,...ab,b->...", phi, C, phi)
 
 
 def node_normals(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
