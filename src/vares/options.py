@@ -7,8 +7,8 @@ declarations:
 
 - the Python API: :func:`takes_options` gives a function one keyword argument per field (with
   the field's default and help) and turns them into the options object;
-- job files: a TOML section is read with :meth:`Options.from_dict`, which refuses unknown keys and
-  names the closest valid spelling;
+- job files: every key of a table is checked against the fields of the options classes that
+  table holds (``vares.app.job``); an unknown key is refused with the closest valid spelling;
 - the command line: ``vares.app.cli`` makes one flag per field from the same spec.
 
 Values are checked and normalised when an options object is made (sequences become tuples, ints
@@ -25,7 +25,15 @@ from dataclasses import MISSING, dataclass, field, fields
 from os import PathLike
 from typing import Any, ClassVar, Self
 
-__all__ = ["Options", "OptionsError", "Spec", "option", "split_settings", "takes_options"]
+__all__ = [
+    "Options",
+    "OptionsError",
+    "Spec",
+    "option",
+    "split_settings",
+    "suggest",
+    "takes_options",
+]
 
 #: Kinds of option values and how they are described in messages.
 KINDS = {
@@ -133,7 +141,7 @@ class Spec:
         if same:
             return same[0]
         raise OptionsError(
-            key, f"must be {self.bounds()}; got {value!r}{_suggest(value, self.choices)}"
+            key, f"must be {self.bounds()}; got {value!r}{suggest(value, self.choices)}"
         )
 
     def _check_str(self, key: str, value: Any) -> str:
@@ -192,7 +200,8 @@ def _is_sequence(value: Any) -> bool:
     return isinstance(value, Sequence) or (hasattr(value, "ndim") and value.ndim == 1)
 
 
-def _suggest(value: str, candidates: Sequence[str] = ()) -> str:
+def suggest(value: str, candidates: Sequence[str] = ()) -> str:
+    """`` (did you mean 'x'?)`` for the closest of ``candidates``, or an empty string."""
     close = difflib.get_close_matches(value, list(candidates), n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
@@ -253,13 +262,6 @@ class Options:
         """Field name → default."""
         return {f.name: f.default for f in fields(cls) if f.default is not MISSING}
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Self:
-        """Options from a mapping; an unknown key is an :class:`OptionsError` that names the
-        closest valid one."""
-        check_keys(data, cls.specs(), cls.title)
-        return cls(**data)
-
     def to_dict(self, *, section: str | None = None) -> dict[str, Any]:
         """The values that are set (not ``None``), tuples as lists; optionally of one section."""
         out = {}
@@ -292,7 +294,7 @@ def check_keys(data: Mapping[str, Any], known: Mapping[str, Any], what: str) -> 
     """Refuse keys of ``data`` that are not in ``known``, suggesting the closest one."""
     for key in data:
         if key not in known:
-            hint = _suggest(key, list(known)) or f"; known: {', '.join(known)}"
+            hint = suggest(key, list(known)) or f"; known: {', '.join(known)}"
             raise OptionsError(None, f"unknown {what} {key!r}{hint}")
 
 

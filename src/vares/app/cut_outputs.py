@@ -19,7 +19,6 @@ from ..io.meshes import write_surface
 from ..structures.seams import named_seam_marks
 from ..units import unit_factor
 from .outcome import JobOutcome
-from .sections import STRUCTURE_MARK_SPACING
 
 __all__ = ["cut_summary", "cutting_details", "nested_drawings", "write_cut"]
 
@@ -137,7 +136,7 @@ def nested_drawings(outcome: JobOutcome) -> list[NestedDrawing]:
     job, result = outcome.job, outcome.cut
     structure, nest = result.structure, result.nest
     to_model = unit_factor(job.output.dxf_units, outcome.units)
-    spacing = (job.output.mark_spacing or STRUCTURE_MARK_SPACING) * to_model
+    spacing = outcome.mark_spacing()
     coordinates = [r.material_coordinates for r in structure.results]
     marks = named_seam_marks(coordinates, structure.seams, spacing)
     units = outcome.units

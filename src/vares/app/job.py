@@ -54,7 +54,7 @@ from pathlib import Path
 from typing import Any
 
 from ..analysis.options import ErectionOptions
-from ..options import Options, OptionsError, Spec
+from ..options import Options, OptionsError, Spec, suggest
 from ..solver.options import SolveOptions
 from ..structures.options import CutOptions, StructureOptions
 from .sections import InputOptions, MaterialOptions, OutputOptions, PrestressOptions
@@ -206,8 +206,7 @@ def _unknown(origin: str, section: str, key: str, own: set[str]) -> None:
     if others:
         hint = f"; it belongs in [{others[0]}]"
     else:
-        close = difflib.get_close_matches(key, sorted(own), n=1, cutoff=0.6)
-        hint = f" (did you mean {close[0]!r}?)" if close else f"; known: {', '.join(sorted(own))}"
+        hint = suggest(key, sorted(own)) or f"; known: {', '.join(sorted(own))}"
     raise JobError(f"{origin}: [{section}] unknown key {key!r}{hint}")
 
 

@@ -12,7 +12,9 @@ from ..materials import Hyperelastic
 from ..solver.result import PatternResult
 from ..structures.cutting import CutResult
 from ..structures.matching import StructureResult
+from ..units import unit_factor
 from .job import Job
+from .sections import STRUCTURE_MARK_SPACING
 
 __all__ = ["JobOutcome", "PanelOutcome"]
 
@@ -50,6 +52,12 @@ class JobOutcome:
     erection: ErectionResult | None = None
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+
+    def mark_spacing(self) -> float:
+        """The spacing of a structure's match marks in the mesh's units (the job gives it in
+        DXF units, else :data:`~vares.app.sections.STRUCTURE_MARK_SPACING`)."""
+        spacing = self.job.output.mark_spacing or STRUCTURE_MARK_SPACING
+        return spacing * unit_factor(self.job.output.dxf_units, self.units)
 
     @property
     def patterned(self) -> bool:

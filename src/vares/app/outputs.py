@@ -39,12 +39,10 @@ from ..io.meshes import write_surface
 from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
-from ..units import METRES
 from .erection_outputs import erection_files
 from .inputs import Input, safe_name
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
-from .sections import STRUCTURE_MARK_SPACING
 
 __all__ = [
     "JOB_FILE",
@@ -195,9 +193,6 @@ def _write_dxf(
 ) -> None:
     result, mesh, output = panel.result, panel.mesh, job.output
     x = result.material_coordinates
-    spacing = output.mark_spacing
-    if marks is not None and spacing is None:
-        spacing = STRUCTURE_MARK_SPACING
     piece = CutPiece(
         panel.name, mesh, x, result.fibres.warp, _label(panel, job), marks=marks, cut=cut
     )
@@ -210,7 +205,7 @@ def _write_dxf(
             units=output.dxf_units,
             model_units=panel.units,
             allowance=output.allowance,
-            mark_spacing=None if marks is not None else spacing,
+            mark_spacing=None if marks is not None else output.mark_spacing,
         ),
     )
 
@@ -281,11 +276,10 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
 
 
 def structure_marks(outcome: JobOutcome) -> list[np.ndarray]:
-    """Matching marks of every panel, at the job's spacing (DXF units) along every seam."""
-    job, structure = outcome.job, outcome.structure
-    factor = METRES[outcome.units] / METRES[job.output.dxf_units]
-    spacing = (job.output.mark_spacing or STRUCTURE_MARK_SPACING) / factor
-    return seam_marks([r.material_coordinates for r in structure.results], structure.seams, spacing)
+    """Matching marks of every panel, at the job's spacing along every seam."""
+    structure = outcome.structure
+    coordinates = [r.material_coordinates for r in structure.results]
+    return seam_marks(coordinates, structure.seams, outcome.mark_spacing())
 
 
 def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None:

@@ -22,7 +22,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from .._version import __version__
-from ..io.files import OutputExistsError, atomic_path
+from ..io.files import OutputExistsError, atomic_path, current_umask
 
 __all__ = ["MANIFEST", "OutputFolder", "add_to_manifest", "listed"]
 
@@ -145,7 +145,7 @@ class OutputFolder:
             self.staging = kept
             shutil.copymode(self.directory, self.staging)
         else:
-            os.chmod(self.staging, 0o777 & ~_umask())
+            os.chmod(self.staging, 0o777 & ~current_umask())
         previous = None
         if self.directory.exists():
             previous = Path(
@@ -162,12 +162,6 @@ class OutputFolder:
         if self.staging is not None:
             shutil.rmtree(self.staging, ignore_errors=True)
             self.staging = None
-
-
-def _umask() -> int:
-    current = os.umask(0)
-    os.umask(current)
-    return current
 
 
 def listed(directory: Path) -> list[Path]:

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
-from ..units import METRES
+from ..units import unit_factor
 from .files import atomic_path
 
 __all__ = [
@@ -120,7 +120,7 @@ def write_dxf(
         raise ValueError(f"the seam allowance must be ≥ 0; got {allowance!r}")
     if mark_spacing is not None and not (np.isfinite(mark_spacing) and mark_spacing > 0):
         raise ValueError(f"the match mark spacing must be > 0; got {mark_spacing!r}")
-    factor = METRES[model_units] / METRES[units]
+    factor = unit_factor(model_units, units)
 
     doc = ezdxf.new("R2010", setup=True)
     doc.header["$INSUNITS"] = INSUNITS[units]
@@ -228,7 +228,7 @@ def write_nest_dxf(
     import ezdxf
     from ezdxf.enums import TextEntityAlignment
 
-    factor = METRES[model_units] / METRES[units]
+    factor = unit_factor(model_units, units)
     doc = ezdxf.new("R2010", setup=True)
     doc.header["$INSUNITS"] = INSUNITS[units]
     doc.header["$MEASUREMENT"] = 1

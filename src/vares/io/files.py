@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputExistsError", "atomic_path", "check_writable", "write_json"]
+__all__ = ["OutputExistsError", "atomic_path", "check_writable", "current_umask", "write_json"]
 
 
 class OutputExistsError(FileExistsError):
@@ -39,7 +39,7 @@ def atomic_path(path: Path):
         dir=path.parent, prefix=f".{path.stem}-", suffix=path.suffix
     )
     os.close(handle)
-    os.chmod(temporary, 0o666 & ~_umask())
+    os.chmod(temporary, 0o666 & ~current_umask())
     try:
         yield Path(temporary)
         os.replace(temporary, path)
@@ -48,7 +48,8 @@ def atomic_path(path: Path):
         raise
 
 
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's file mode creation mask (read without changing it for good)."""
     current = os.umask(0)
     os.umask(current)
     return current

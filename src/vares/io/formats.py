@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.mesh import MeshError
+from .dxf import INSUNITS
 
 __all__ = ["DXF_UNITS", "PolygonSoup", "read_dxf", "read_obj", "read_off"]
 
@@ -152,7 +153,7 @@ def _text(path: Path) -> str:
 
 
 #: DXF drawing units (``$INSUNITS``) and vares' names for them; 0 is "unitless".
-DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m"}
+DXF_UNITS = {code: name for name, code in INSUNITS.items()}
 
 
 def read_dxf(path: Path) -> tuple[PolygonSoup, str | None, np.ndarray, list[str]]:
