@@ -12,7 +12,11 @@ SQUARE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
 
 def test_mixed_mesh_areas_and_read_only(mixed_mesh):
     assert mixed_mesh.num_cells == 8
-    assert mixed_mesh.area > 1.0
+    p = mixed_mesh.points
+    t, q = p[mixed_mesh.cells["triangle"]], p[mixed_mesh.cells["quad"]]  # quads are flat here
+    triangles = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    quads = 0.5 * np.linalg.norm(np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]), axis=1)
+    assert mixed_mesh.area == pytest.approx(triangles.sum() + quads.sum(), rel=1e-12)
     with pytest.raises(ValueError):
         mixed_mesh.points[0, 0] = 5.0
     with pytest.raises(ValueError):
