@@ -5,7 +5,8 @@
 For every surface and every installed linear solver (or those named): a full ``vares.solve``
 with the default strategy (Neo-Hooke, E = 1000, ν = 0.3), timed, with every factorisation and
 solve of the tangent timed on its own. Printed per row: cells, unknowns, the start, Newton
-iterations, the solve's wall time, the slowest linear solve (factorisation + back-substitution)
+iterations, factorisations and conjugate-gradient iterations (solvers whose factorisation is dear
+reuse it, vares.solver.reuse), the solve's wall time, the slowest linear solve of a Newton step
 and that figure per 100k unknowns (a direct solver's cost grows faster than the unknowns, so
 this is the figure that must stay at a few seconds). Files are read as the ``vares`` command
 reads them (repair included); the real-world-like set is written to files first (the scan as
@@ -16,12 +17,14 @@ back the same way. A warm-up solve comes first, so compiled code is loaded.
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import platform
 import tempfile
 import time
 import warnings
 from pathlib import Path
+from typing import ClassVar
 
 import meshio
 import numpy as np
@@ -30,26 +33,37 @@ import vares
 from vares import examples
 from vares.io.meshes import read_mesh_file
 from vares.solver import linear
+from vares.solver.reuse import ReusingSolver
 from vares.units import unit_factor
 
 MESH_SUFFIXES = {".obj", ".off", ".stl", ".ply", ".vtu", ".vtk", ".msh", ".3dm"}
 
 
-class Timed:
-    """Wraps a linear solver: the wall time of every factorisation + solve pair."""
+class Timed(ReusingSolver):
+    """The Newton systems' solver, timing every linear solve of a Newton step (a factorisation
+    and its solve, or conjugate gradients preconditioned by an earlier factorisation)."""
 
-    def __init__(self, inner) -> None:
-        self.inner, self.name, self.times = inner, inner.name, []
-        self._started = 0.0
+    times: ClassVar[list[float]] = []
 
-    def factorize(self, matrix) -> None:
-        self._started = time.perf_counter()
-        self.inner.factorize(matrix)
+    def __init__(self, solver) -> None:
+        super().__init__(solver)
+        self._depth = 0
 
-    def solve(self, rhs):
-        out = self.inner.solve(rhs)
-        self.times.append(time.perf_counter() - self._started)
-        return out
+    def solve(self, matrix, rhs, rtol=0.0):
+        return self._timed(super().solve, matrix, rhs, rtol)
+
+    def exact(self, matrix, rhs):
+        return self._timed(super().exact, matrix, rhs)
+
+    def _timed(self, call, *args):
+        self._depth += 1
+        started = time.perf_counter()
+        try:
+            return call(*args)
+        finally:
+            self._depth -= 1
+            if self._depth == 0:
+                Timed.times.append(time.perf_counter() - started)
 
 
 def surfaces(large: bool, files: list[Path], folder: Path):
@@ -99,39 +113,28 @@ def main() -> None:
     )
     print(
         f"{'surface':<40} {'cells':>7} {'unknowns':>8} {'solver':<13} {'ok':<3} {'start':<10} "
-        f"{'it':>3} {'time s':>7} {'max lin s':>9} {'per 100k':>8}"
+        f"{'it':>3} {'fac':>4} {'cg':>4} {'time s':>7} {'max lin s':>9} {'per 100k':>8}"
     )
-    original = linear.get_solver
     worst = 0.0
+    importlib.import_module("vares.solver.newton").ReusingSolver = Timed
     with tempfile.TemporaryDirectory() as tmp:
         for name, mesh in surfaces(args.large, args.files, Path(tmp)):
             for solver in solvers:
-                timed: list[Timed] = []
-
-                def wrapped(requested=None, _timed=timed):
-                    _timed.append(Timed(original(requested)))
-                    return _timed[-1]
-
-                linear.get_solver = wrapped
-                vares.solver.api.get_solver = wrapped
-                try:
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore")
-                        start = time.perf_counter()
-                        result = vares.solve(mesh, material, linear_solver=solver)
-                        elapsed = time.perf_counter() - start
-                finally:
-                    linear.get_solver = original
-                    vares.solver.api.get_solver = original
-                times = [t for solver_ in timed for t in solver_.times]
+                Timed.times = []
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    start = time.perf_counter()
+                    result = vares.solve(mesh, material, linear_solver=solver)
+                    elapsed = time.perf_counter() - start
                 unknowns = 2 * mesh.num_points
-                slowest = max(times, default=0.0)
+                slowest = max(Timed.times, default=0.0)
                 per = slowest * 1e5 / unknowns
                 worst = max(worst, per)
                 print(
                     f"{name[:40]:<40} {mesh.num_cells:>7} {unknowns:>8} {solver:<13} "
                     f"{'yes' if result.converged else 'NO':<3} {result.initial_guess:<10} "
-                    f"{result.iterations:>3} {elapsed:>7.2f} {slowest:>9.3f} {per:>8.3f}",
+                    f"{result.iterations:>3} {result.factorisations:>4} {result.cg_iterations:>4} "
+                    f"{elapsed:>7.2f} {slowest:>9.3f} {per:>8.3f}",
                     flush=True,
                 )
     print(f"slowest linear solve per 100k unknowns, over every row: {worst:.3f} s")

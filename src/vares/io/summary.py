@@ -30,6 +30,8 @@ def summary(result: PatternResult, **extra: object) -> dict:
         "options": result.options.to_dict(),
         "linear_solver": result.linear_solver,
         "linear_solver_choice": solver_choice(result.options.linear_solver, result.linear_solver),
+        "factorisations": result.factorisations,
+        "cg_iterations": result.cg_iterations,
         "elapsed_seconds": result.elapsed,
         "warm_up_seconds": result.warm_up,
         "mesh": {
@@ -72,6 +74,8 @@ def summary(result: PatternResult, **extra: object) -> dict:
             "relative_residual": r.relative_residual,
             "energy": r.energy,
             "damping": r.damping,
+            "factorisations": r.factorisations,
+            "cg_iterations": r.cg_iterations,
         }
         for r in result.history
     ]

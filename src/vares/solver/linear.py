@@ -44,9 +44,12 @@ class SingularMatrixError(RuntimeError):
 
 
 class LinearSolver(Protocol):
-    """Factorise a sparse symmetric matrix, then solve with it."""
+    """Factorise a sparse symmetric matrix, then solve with it. ``reuse_iterations``: how
+    many conjugate-gradient iterations preconditioned by the last factorisation may stand in
+    for a new one (:mod:`vares.solver.reuse`; about what a factorisation costs in solves)."""
 
     name: str
+    reuse_iterations: int
 
     def factorize(self, matrix: sp.csr_matrix) -> None: ...
 
@@ -82,6 +85,8 @@ class SuperLUSolver:
     """
 
     name = "scipy-superlu"
+    #: a factorisation costs about 30 solves (100k-triangle hypar: 0.54 s against 0.018 s)
+    reuse_iterations = 20
 
     def __init__(self) -> None:
         self._lu = None
@@ -142,6 +147,8 @@ class PardisoSolver:
     """
 
     name = "pardiso"
+    #: a factorisation costs about four solves (0.06 s against 0.015 s): factorise every tangent
+    reuse_iterations = 0
 
     def __init__(self) -> None:
         global _PARDISO
@@ -285,6 +292,8 @@ class CholmodSolver:
     """CHOLMOD supernodal Cholesky; indefinite matrices go to ``fallback``."""
 
     name = "cholmod"
+    #: a factorisation costs about 15 solves (0.24–0.31 s against 0.017 s)
+    reuse_iterations = 12
 
     def __init__(self, fallback: LinearSolver | None = None) -> None:
         from sksparse import cholmod

@@ -16,7 +16,7 @@ are ``x.ravel()[assembler.free]``, optionally subject to one linear constraint `
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -25,6 +25,7 @@ from ..materials import InadmissibleState
 from ..mechanics.assembly import Assembler
 from .linear import LinearSolver, SingularMatrixError
 from .result import IterationRecord, StepRecord
+from .reuse import ReusingSolver, forcing_term
 
 __all__ = [
     "EXACT_TANGENT_BELOW",
@@ -97,6 +98,11 @@ class NewtonContext:
     #: round-off floor where states switch, and sets it lower.
     round_off_regime: float = ROUND_OFF_REGIME
 
+    def __post_init__(self) -> None:
+        #: the linear solver, reusing its factorisations where that is cheaper (inexact Newton)
+        self.systems = ReusingSolver(self.linear_solver)
+        self._counted = (0, 0)
+
     def residual(self, gradient: np.ndarray) -> np.ndarray:
         """The residual over the free dofs, less its component along the linear constraint."""
         r = gradient.ravel()[self.assembler.free]
@@ -104,17 +110,24 @@ class NewtonContext:
             r = r - self.constraint * (self.constraint @ r)
         return r
 
-    def step(self, matrix: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
-        """Solve the Newton system, bordered by the linear constraint when there is one."""
+    def step(self, matrix: sp.csr_matrix, rhs: np.ndarray, rtol: float = 0.0) -> np.ndarray:
+        """Solve the Newton system to relative residual ``rtol`` (0: exactly), bordered by the
+        linear constraint when there is one (a saddle point: always factorised)."""
         if self.constraint is None:
-            self.linear_solver.factorize(matrix)
-            return self.linear_solver.solve(rhs)
+            return self.systems.solve(matrix, rhs, rtol)
         column = sp.csr_matrix(self.constraint[:, None])
         bordered = sp.bmat([[matrix, column], [column.T, None]], format="csr")
-        self.linear_solver.factorize(bordered)
-        return self.linear_solver.solve(np.append(rhs, 0.0))[:-1]
+        return self.systems.exact(bordered, np.append(rhs, 0.0))[:-1]
 
     def record(self, record: IterationRecord) -> None:
+        """Keep ``record``, with the linear work done since the record before it."""
+        counted = (self.systems.factorisations, self.systems.cg_iterations)
+        record = replace(
+            record,
+            factorisations=counted[0] - self._counted[0],
+            cg_iterations=counted[1] - self._counted[1],
+        )
+        self._counted = counted
         self.history.append(record)
         if self.callback is not None:
             self.callback(record)
@@ -190,6 +203,7 @@ def newton(
     step_lengths: list[float] = []
     evaluation = None  # the line search's evaluation of the point it accepted, if it has one
     squeezed = 0  # iterations in a row whose steps a fold held back, each shorter
+    norms: list[float] = []  # the residual norms of this iteration
     for iteration in range(ctx.max_iterations + 1):
         if evaluation is None:
             try:
@@ -234,8 +248,10 @@ def newton(
             return x
         if iteration == ctx.max_iterations:
             raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
+        norms.append(residual)
+        eta = forcing_term(norms, ctx.residual_tolerance)
         if method == "full":
-            x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector)
+            x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector, eta)
             evaluation = None
         elif method == "damped":
             x, step_length, tangent = _damped_step(
@@ -243,7 +259,9 @@ def newton(
             )
             evaluation = None
         else:
-            search = _LineSearch(problem, x, ctx, evaluation, matrix, residual_vector, projected)
+            search = _LineSearch(
+                problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
+            )
             # the search owns the tangent now: it lets go of it before evaluating a trial point
             del evaluation, matrix, hessians
             x, step_length, tangent, evaluation = search.step()
@@ -259,10 +277,10 @@ def newton(
     raise AssertionError("unreachable")
 
 
-def _full_step(problem, x, ctx, matrix, residual_vector):
-    """A plain Newton step; one that inverts a cell ends the iteration."""
+def _full_step(problem, x, ctx, matrix, residual_vector, eta):
+    """A plain (inexact) Newton step; one that inverts a cell ends the iteration."""
     try:
-        delta = ctx.step(matrix, -residual_vector)
+        delta = ctx.step(matrix, -residual_vector, eta)
     except SingularMatrixError as exc:
         raise Failure(f"singular tangent ({exc})", x) from exc
     trial = x.copy()
@@ -323,8 +341,10 @@ class _LineSearch:
     must be tried.
     """
 
-    def __init__(self, problem, x, ctx, evaluation, matrix, residual_vector, projected) -> None:
-        self.problem, self.x, self.ctx = problem, x, ctx
+    def __init__(
+        self, problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
+    ) -> None:
+        self.problem, self.x, self.ctx, self.eta = problem, x, ctx, eta
         self.evaluation, self.matrix = evaluation, matrix
         self.energy = evaluation.energy
         self.residual_vector, self.projected = residual_vector, projected
@@ -341,7 +361,7 @@ class _LineSearch:
                     self.evaluation = problem.evaluate(x, order=2)
                 self.matrix = ctx.assembler.matrix(problem.projected_hessians(self.evaluation))
             try:
-                delta = ctx.step(self.matrix, -self.residual_vector)
+                delta = ctx.step(self.matrix, -self.residual_vector, self.eta)
             except SingularMatrixError:
                 continue
             slope = float(self.residual_vector @ delta)

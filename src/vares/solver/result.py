@@ -22,7 +22,10 @@ class IterationRecord:
 
     ``damping`` is the damping coefficient used to reach this state, ``step_length`` the line
     search's step length and ``tangent`` the matrix of that step (``"exact"``, ``"projected"``
-    or ``"damped"``); the last three are 0 or empty at iteration 0.
+    or ``"damped"``); the last three are 0 or empty at iteration 0. ``factorisations`` and
+    ``cg_iterations`` count the linear solver's work since the record before: numeric
+    factorisations and conjugate-gradient iterations preconditioned by an earlier
+    factorisation (:mod:`vares.solver.reuse`).
     """
 
     strategy: str
@@ -35,6 +38,8 @@ class IterationRecord:
     damping: float
     step_length: float = 0.0
     tangent: str = ""
+    factorisations: int = 0
+    cg_iterations: int = 0
 
 
 @dataclass(frozen=True)
@@ -117,6 +122,16 @@ class PatternResult:
     def iterations(self) -> int:
         """Number of Newton iterations (linear solves) over all steps."""
         return sum(1 for r in self.history if r.iteration > 0)
+
+    @property
+    def factorisations(self) -> int:
+        """Numeric factorisations of the tangent over all steps."""
+        return sum(r.factorisations for r in self.history)
+
+    @property
+    def cg_iterations(self) -> int:
+        """Conjugate-gradient iterations (preconditioned by an earlier factorisation)."""
+        return sum(r.cg_iterations for r in self.history)
 
     @property
     def surface_area(self) -> float:

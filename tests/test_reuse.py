@@ -1,0 +1,144 @@
+"""Inexact Newton: forcing terms, conjugate gradients preconditioned by an earlier
+factorisation, and what that does to a solve."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import vares
+from vares import examples
+from vares.solver import linear
+from vares.solver.reuse import ETA_MAX, ReusingSolver, forcing_term, preconditioned_cg
+
+NEO_HOOKE = vares.materials.NeoHooke(1000.0, 0.3)
+
+
+def _laplacian(n: int, shift: float = 0.1) -> sp.csr_matrix:
+    """A 2D grid Laplacian plus ``shift`` on the diagonal: positive definite, size n²."""
+    one = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    return (sp.kronsum(one, one) + shift * sp.identity(n * n)).tocsr()
+
+
+def test_forcing_term_follows_eisenstat_walker_and_the_tolerance():
+    assert forcing_term([1.0], 1e-10) == ETA_MAX  # first iteration: the loosest
+    # 0.9 (r_k / r_{k-1})^2
+    assert forcing_term([1.0, 0.01], 1e-12) == pytest.approx(0.9e-4)
+    assert forcing_term([3.0, 1.0, 0.2], 1e-12) == pytest.approx(0.9 * 0.04)
+    # never tighter than half of what the tolerance asks of the next iterate
+    assert forcing_term([1.0, 1e-6], 1e-10) == pytest.approx(0.5e-10 / 1e-6)
+    # a residual that grew, or fell little: the loosest
+    assert forcing_term([1.0, 2.0], 1e-10) == ETA_MAX
+    assert forcing_term([1.0, 0.5], 1e-10) == ETA_MAX
+
+
+def test_cg_with_the_exact_inverse_takes_one_iteration():
+    matrix = _laplacian(12)
+    rhs = np.random.default_rng(0).standard_normal(matrix.shape[0])
+    lu = sp.linalg.splu(matrix.tocsc())
+    x, iterations = preconditioned_cg(matrix, rhs, lu.solve, 1e-12, budget=5)
+    assert iterations == 1
+    np.testing.assert_allclose(matrix @ x, rhs, atol=1e-10 * np.linalg.norm(rhs))
+
+
+def test_cg_with_a_nearby_factorisation_reaches_the_tolerance_asked():
+    matrix = _laplacian(20)
+    rng = np.random.default_rng(1)
+    changed = matrix + sp.diags(rng.uniform(0.0, 0.3, matrix.shape[0]))  # a later tangent
+    lu = sp.linalg.splu(matrix.tocsc())
+    rhs = rng.standard_normal(matrix.shape[0])
+    for rtol in (1e-2, 1e-6, 1e-10):
+        x, iterations = preconditioned_cg(changed, rhs, lu.solve, rtol, budget=40)
+        assert x is not None and iterations >= 2
+        assert np.linalg.norm(rhs - changed @ x) <= rtol * np.linalg.norm(rhs)
+
+
+def test_cg_gives_up_on_an_indefinite_matrix_and_beyond_its_budget():
+    matrix = _laplacian(10)
+    rhs = np.ones(matrix.shape[0])
+    indefinite = (matrix - 2.0 * sp.identity(matrix.shape[0])).tocsr()
+    x, _ = preconditioned_cg(indefinite, rhs, lambda r: r, 1e-8, budget=200)
+    assert x is None  # negative curvature met, not iterated through
+    # unpreconditioned CG on a Laplacian converges slowly: its rate shows it early
+    x, iterations = preconditioned_cg(_laplacian(30, 1e-3), np.ones(900), lambda r: r, 1e-10, 8)
+    assert x is None and iterations <= 8
+    zero, iterations = preconditioned_cg(matrix, np.zeros(matrix.shape[0]), lambda r: r, 1e-8, 5)
+    assert iterations == 0 and not zero.any()
+
+
+def test_reusing_solver_factorises_only_when_it_must():
+    solver = ReusingSolver(linear.get_solver("scipy-superlu"))
+    assert solver.budget > 0
+    matrix = _laplacian(16)
+    rng = np.random.default_rng(3)
+    rhs = rng.standard_normal(matrix.shape[0])
+    solver.solve(matrix, rhs, rtol=1e-3)  # nothing to reuse yet
+    assert (solver.factorisations, solver.cg_iterations) == (1, 0)
+    later = (matrix + sp.diags(rng.uniform(0.0, 0.05, matrix.shape[0]))).tocsr()
+    x = solver.solve(later, rhs, rtol=1e-8)
+    assert solver.factorisations == 1 and solver.cg_iterations > 0
+    assert np.linalg.norm(rhs - later @ x) <= 1e-8 * np.linalg.norm(rhs)
+    solver.solve(later, rhs)  # an exact solve asked: factorised
+    assert solver.factorisations == 2
+    smaller = _laplacian(15)  # another size: the factorisation cannot precondition it
+    solver.solve(smaller, rhs[: smaller.shape[0]], rtol=1e-3)
+    assert solver.factorisations == 3
+    # the same size as the last, but nothing like it: CG gives up and the matrix is factorised
+    far = (smaller + sp.diags(rng.uniform(0.0, 40.0, smaller.shape[0]))).tocsr()
+    iterations = solver.cg_iterations
+    x = solver.solve(far, rhs[: far.shape[0]], rtol=1e-10)
+    assert solver.factorisations == 4 and solver.cg_iterations > iterations
+    np.testing.assert_allclose(far @ x, rhs[: far.shape[0]], atol=1e-9 * np.linalg.norm(rhs))
+
+
+def test_a_solver_that_never_reuses_factorises_every_system():
+    solver = ReusingSolver(linear.get_solver("scipy-superlu"))
+    solver.budget = 0
+    matrix = _laplacian(8)
+    for _ in range(3):
+        solver.solve(matrix, np.ones(matrix.shape[0]), rtol=0.1)
+    assert (solver.factorisations, solver.cg_iterations) == (3, 0)
+
+
+def test_inexact_newton_finds_the_same_pattern_with_one_factorisation():
+    """SuperLU reuses its first factorisation: the same optimum as exact Newton (every tangent
+    factorised) to round-off, in as many Newton iterations, ending superlinearly."""
+    mesh = examples.hypar(size=10.0, rise=0.06, n=40)
+    inexact = vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu")
+    exact_solver = linear.SuperLUSolver()
+    exact_solver.reuse_iterations = 0
+    reference = _solve_with(mesh, exact_solver)
+    assert inexact.converged and reference.converged
+    assert reference.factorisations == reference.iterations and reference.cg_iterations == 0
+    assert inexact.factorisations == 1 and inexact.cg_iterations >= inexact.iterations - 1
+    assert inexact.iterations <= reference.iterations + 1
+    assert inexact.energy == pytest.approx(reference.energy, rel=1e-12)
+    np.testing.assert_allclose(
+        inexact.material_coordinates, reference.material_coordinates, atol=1e-10 * 10.0
+    )
+    residuals = [r.relative_residual for r in inexact.history]
+    assert residuals[-1] <= 1e-10
+    assert residuals[-1] < 1e-2 * residuals[-2]  # superlinear at the end, not linear
+
+
+def _solve_with(mesh, solver):
+    """A solve whose context gets ``solver`` (an instance) instead of a new one by name."""
+    original = linear._SOLVERS["scipy-superlu"]
+    linear._SOLVERS["scipy-superlu"] = lambda: solver
+    try:
+        return vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu")
+    finally:
+        linear._SOLVERS["scipy-superlu"] = original
+
+
+def test_the_history_counts_the_linear_work():
+    mesh = examples.hypar(n=12)
+    result = vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu")
+    assert result.history[0].factorisations == 0 and result.history[0].cg_iterations == 0
+    assert result.factorisations + result.cg_iterations >= result.iterations
+    from vares.io.summary import summary
+
+    written = summary(result)
+    assert written["factorisations"] == result.factorisations
+    assert written["cg_iterations"] == result.cg_iterations
