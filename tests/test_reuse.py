@@ -142,3 +142,39 @@ def test_the_history_counts_the_linear_work():
     written = summary(result)
     assert written["factorisations"] == result.factorisations
     assert written["cg_iterations"] == result.cg_iterations
+
+
+def test_a_definite_only_solver_refuses_an_indefinite_matrix_when_asked():
+    pytest.importorskip("sksparse")
+    solver = linear.get_solver("cholmod")
+    indefinite = (_laplacian(6) - 0.5 * sp.identity(36)).tocsr()
+    rhs = np.ones(36)
+    with pytest.raises(linear.IndefiniteMatrixError):
+        solver.factorize(indefinite, definite=True)
+    solver.factorize(indefinite)  # passed on to SuperLU
+    np.testing.assert_allclose(indefinite @ solver.solve(rhs), rhs, atol=1e-10)
+
+
+class _DefiniteOnly(linear.SuperLUSolver):
+    """SuperLU that refuses every matrix it is asked to factorise as a definite one (and
+    factorises every tangent)."""
+
+    refused = 0
+    reuse_iterations = 0
+
+    def factorize(self, matrix, definite=False):
+        if definite:
+            _DefiniteOnly.refused += 1
+            raise linear.IndefiniteMatrixError("refused")
+        super().factorize(matrix)
+
+
+def test_globalised_newton_takes_the_projected_tangent_where_the_exact_one_is_refused():
+    mesh = examples.hypar(size=10.0, rise=0.06, n=16)
+    reference = vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu")
+    _DefiniteOnly.refused = 0
+    result = _solve_with(mesh, _DefiniteOnly())
+    assert result.converged and _DefiniteOnly.refused > 0
+    tangents = {r.tangent for r in result.history[1:]}
+    assert "projected" in tangents
+    assert result.energy == pytest.approx(reference.energy, rel=1e-10)

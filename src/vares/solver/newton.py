@@ -110,11 +110,15 @@ class NewtonContext:
             r = r - self.constraint * (self.constraint @ r)
         return r
 
-    def step(self, matrix: sp.csr_matrix, rhs: np.ndarray, rtol: float = 0.0) -> np.ndarray:
+    def step(
+        self, matrix: sp.csr_matrix, rhs: np.ndarray, rtol: float = 0.0, definite: bool = False
+    ) -> np.ndarray:
         """Solve the Newton system to relative residual ``rtol`` (0: exactly), bordered by the
-        linear constraint when there is one (a saddle point: always factorised)."""
+        linear constraint when there is one (a saddle point: always factorised). ``definite``:
+        the caller has a definite matrix to try should this one be indefinite
+        (:class:`~vares.solver.linear.IndefiniteMatrixError` instead of a slow fallback)."""
         if self.constraint is None:
-            return self.systems.solve(matrix, rhs, rtol)
+            return self.systems.solve(matrix, rhs, rtol, definite)
         column = sp.csr_matrix(self.constraint[:, None])
         bordered = sp.bmat([[matrix, column], [column.T, None]], format="csr")
         return self.systems.exact(bordered, np.append(rhs, 0.0))[:-1]
@@ -361,7 +365,9 @@ class _LineSearch:
                     self.evaluation = problem.evaluate(x, order=2)
                 self.matrix = ctx.assembler.matrix(problem.projected_hessians(self.evaluation))
             try:
-                delta = ctx.step(self.matrix, -self.residual_vector, self.eta)
+                delta = ctx.step(
+                    self.matrix, -self.residual_vector, self.eta, definite=attempt == "exact"
+                )
             except SingularMatrixError:
                 continue
             slope = float(self.residual_vector @ delta)

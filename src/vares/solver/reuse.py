@@ -111,20 +111,26 @@ class ReusingSolver:
         self.factorisations = 0
         self.cg_iterations = 0
 
-    def solve(self, matrix: sp.spmatrix, rhs: np.ndarray, rtol: float = 0.0) -> np.ndarray:
+    def solve(
+        self, matrix: sp.spmatrix, rhs: np.ndarray, rtol: float = 0.0, definite: bool = False
+    ) -> np.ndarray:
         """``matrix⁻¹ rhs``, to relative residual ``rtol`` (0: as exactly as the factorisation
-        solves it)."""
+        solves it). ``definite``: rather :class:`~vares.solver.linear.IndefiniteMatrixError`
+        than a slow fallback when the back end factorises definite matrices only."""
         if rtol > 0 and self.budget > 0 and self._size == matrix.shape[0]:
             x, iterations = preconditioned_cg(matrix, rhs, self.solver.solve, rtol, self.budget)
             self.cg_iterations += iterations
             if x is not None:
                 return x
-        return self.exact(matrix, rhs)
+        return self.exact(matrix, rhs, definite)
 
-    def exact(self, matrix: sp.spmatrix, rhs: np.ndarray) -> np.ndarray:
+    def exact(self, matrix: sp.spmatrix, rhs: np.ndarray, definite: bool = False) -> np.ndarray:
         """Factorise ``matrix`` (it becomes the preconditioner of later solves) and solve."""
         self._size = None
-        self.solver.factorize(matrix)
         self.factorisations += 1
+        if definite:
+            self.solver.factorize(matrix, definite=True)
+        else:
+            self.solver.factorize(matrix)
         self._size = matrix.shape[0]
         return self.solver.solve(rhs)
