@@ -45,7 +45,12 @@ def run_vares(mesh, solver: str | None) -> tuple[float, dict]:
     result = vares.solve(vares.SurfaceMesh(points, cells), material, linear_solver=solver)
     elapsed = time.perf_counter() - start
     assert result.converged, result.reason
-    return elapsed, {"iterations": result.iterations, "solver": result.linear_solver}
+    return elapsed, {
+        "iterations": result.iterations,
+        "solver": result.linear_solver,
+        "factorisations": result.factorisations,
+        "cg": result.cg_iterations,
+    }
 
 
 def run_arap(mesh) -> tuple[float, dict]:
@@ -98,7 +103,8 @@ def main() -> None:
         print(f"{name:<6} median {median[name]:.3f} s  (runs: {shown})")
     print(
         f"vares / (LSCM + ARAP) = {median['vares'] / median['arap']:.2f}; vares: "
-        f"{info['iterations']} Newton iterations, {info['solver']}; peak {peak_mib():.0f} MiB"
+        f"{info['iterations']} Newton iterations, {info['solver']} ({info['factorisations']} "
+        f"factorisations, {info['cg']} CG iterations); peak {peak_mib():.0f} MiB"
     )
     command = f"python benchmarks/race.py --triangles {args.triangles} --repeat {args.repeat}"
     print(f"reproduce: {command}" + (f" --solver {args.solver}" if args.solver else ""))

@@ -392,3 +392,14 @@ def test_the_vares_script_exits_with_the_commands_status(tmp_path):
     )
     assert missing.returncode == 2
     assert "no such file" in missing.stderr
+
+
+def test_version_and_help():
+    from vares import __version__
+
+    result = run("--version")
+    assert result.exit_code == 0 and result.stdout.strip() == f"vares {__version__}"
+    result = run("--help")
+    assert result.exit_code == 0
+    for command in ("pattern", "run", "panels", "cut", "erect", "batch", "--version"):
+        assert command in result.stdout

@@ -25,6 +25,23 @@ for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, ba
     app.command()(command)
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        from ..._version import __version__
+
+        typer.echo(f"vares {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(
+        False, "--version", callback=_print_version, is_eager=True, help="Print the version."
+    ),
+) -> None:
+    """Cutting patterns of doubly curved membranes by the Variation of Reference Strategy."""
+
+
 def main() -> None:
     """Entry point of the ``vares`` script.
 
