@@ -259,3 +259,36 @@ def test_pseudo_time_reports_an_overlapping_pattern_without_restarting(monkeypat
     result = vares.solve(mesh, NEO_HOOKE, strategy="pseudo-time")
     assert not result.converged and result.overlap is crossing
     assert result.initial_guess == "projection"
+
+
+def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
+    """A run killed mid-way leaves its hidden staging folder; the next run into the same
+    folder removes it when its process has ended, and leaves a live run's and a kept one."""
+    import os
+    import subprocess
+    import sys
+
+    from vares.app.staging import OWNER
+
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)  # fmt: skip
+    host = __import__("socket").gethostname()
+    folders = {}
+    for name, pid in (("killed", int(ended.stdout)), ("running", os.getppid())):
+        folder = tmp_path / f".out.vares-{name}"
+        folder.mkdir()
+        (folder / "pattern.dxf").write_text("half written")
+        (folder / OWNER).write_text(json.dumps({"pid": pid, "host": host}))
+        folders[name] = folder
+    kept = tmp_path / ".out.vares-kept"  # a finished run kept beside: names no process
+    kept.mkdir()
+    (kept / "pattern.dxf").write_text("finished")
+    other = tmp_path / ".other.vares-killed"  # another output folder's
+    other.mkdir()
+    (other / OWNER).write_text(json.dumps({"pid": int(ended.stdout), "host": host}))
+    assert run("example", "hypar", "-o", tmp_path / "out", "-q").exit_code == 0
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == [".other.vares-killed", ".out.vares-kept", ".out.vares-running", "out"]
+    assert not (tmp_path / "out" / OWNER).exists()
+    manifest = json.loads((tmp_path / "out" / ".vares-run.json").read_text())
+    assert OWNER not in manifest["files"]

@@ -4,7 +4,10 @@ A run writes its files into a hidden staging folder next to the output folder. W
 is written, the staging folder takes the output folder's place (the previous run, if any, is
 moved aside first and then deleted), so an output folder holds one whole run or the previous
 one — never a mix, also when a run is interrupted. A manifest (``.vares-run.json``) lists the
-files of the run, so the next run knows which files it may replace.
+files of the run, so the next run knows which files it may replace. A staging folder left by a
+process that was killed (it names its process in ``.vares-staging.json``) is removed by the next
+run into the same folder on the same machine; one without that name (a finished run kept beside
+a folder that changed meanwhile) is never removed.
 
 Before any work :meth:`OutputFolder.check` refuses what would lose something: an output path
 that is a file, a folder holding files vares did not write (they would be lost), an existing
@@ -14,9 +17,11 @@ An input that a previous run wrote into the folder (a job file saved there) is c
 
 from __future__ import annotations
 
+import glob
 import json
 import os
 import shutil
+import socket
 import tempfile
 from collections.abc import Iterable
 from pathlib import Path
@@ -28,6 +33,8 @@ __all__ = ["MANIFEST", "OutputFolder", "add_to_manifest", "listed"]
 
 #: The file in an output folder that lists what the run wrote.
 MANIFEST = ".vares-run.json"
+#: The file in a staging folder naming the process that writes it (removed before the swap).
+OWNER = ".vares-staging.json"
 
 
 class OutputFolder:
@@ -114,10 +121,13 @@ class OutputFolder:
 
     # ------------------------------------------------------------------ the work
     def start(self) -> Path:
-        """Create the staging folder; the run writes into it."""
+        """Create the staging folder (removing those of killed runs); the run writes into it."""
+        _remove_abandoned(self.directory)
         self.staging = Path(
             tempfile.mkdtemp(prefix=f".{self.directory.name}.vares-", dir=self.directory.parent)
         )
+        owner = {"pid": os.getpid(), "host": socket.gethostname()}
+        (self.staging / OWNER).write_text(json.dumps(owner), encoding="utf-8")
         planned = set(self.planned)
         for path in self.inputs:  # inputs a previous run wrote here stay with the new run
             if self.directory in path.parents and path not in planned:
@@ -132,6 +142,7 @@ class OutputFolder:
 
     def commit(self) -> None:
         """Put the staged run in place of the output folder (module docs)."""
+        (self.staging / OWNER).unlink(missing_ok=True)
         files = sorted(
             str(p.relative_to(self.staging)) for p in self.staging.rglob("*") if p.is_file()
         )
@@ -162,6 +173,33 @@ class OutputFolder:
         if self.staging is not None:
             shutil.rmtree(self.staging, ignore_errors=True)
             self.staging = None
+
+
+def _remove_abandoned(directory: Path) -> None:
+    """Remove the staging folders beside ``directory`` whose process, on this machine, has
+    ended (killed mid-run: an interrupted run removes its own). POSIX only: elsewhere a process
+    cannot be asked whether it lives without a handle to it."""
+    if os.name != "posix":
+        return
+    host = socket.gethostname()
+    for folder in directory.parent.glob(f".{glob.escape(directory.name)}.vares-*"):
+        try:
+            owner = json.loads((folder / OWNER).read_text(encoding="utf-8"))
+            pid, same_host = int(owner["pid"]), owner["host"] == host
+        except (OSError, ValueError, KeyError, TypeError):
+            continue  # no owner named: a finished run kept beside the folder, or not ours
+        if same_host and pid != os.getpid() and not _alive(pid):
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
 
 
 def listed(directory: Path) -> list[Path]:
