@@ -49,17 +49,17 @@ class Timed(ReusingSolver):
         super().__init__(solver)
         self._depth = 0
 
-    def solve(self, matrix, rhs, rtol=0.0):
-        return self._timed(super().solve, matrix, rhs, rtol)
+    def solve(self, *args, **kwargs):
+        return self._timed(super().solve, *args, **kwargs)
 
-    def exact(self, matrix, rhs):
-        return self._timed(super().exact, matrix, rhs)
+    def exact(self, *args, **kwargs):
+        return self._timed(super().exact, *args, **kwargs)
 
-    def _timed(self, call, *args):
+    def _timed(self, call, *args, **kwargs):
         self._depth += 1
         started = time.perf_counter()
         try:
-            return call(*args)
+            return call(*args, **kwargs)
         finally:
             self._depth -= 1
             if self._depth == 0:
