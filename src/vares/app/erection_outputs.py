@@ -42,7 +42,7 @@ def write_erection(result: ErectionResult, directory: Path, units: str) -> list[
     """The files of an erection (:data:`ERECTION_FILES`) in ``directory``; returns their paths."""
     import matplotlib.pyplot as plt
 
-    from ..io.plot import plot_surface
+    from ..io.plot import DPI, plot_surface
 
     files = []
     fields = dict(result.fields) | {f"design_{k}": v for k, v in result.design_fields.items()}
@@ -82,7 +82,7 @@ def write_erection(result: ErectionResult, directory: Path, units: str) -> list[
             stress_scale=scale,
         )
         with atomic_path(directory / name) as temporary:
-            fig.savefig(temporary, dpi=150)
+            fig.savefig(temporary, dpi=DPI)
         plt.close(fig)
         files.append(directory / name)
     return files
