@@ -14,7 +14,7 @@ import numpy as np
 
 from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path
-from .html_parts import figure, number, page, picture, status_text, table
+from .html_parts import DPI, drawing, figure, number, page, picture, status_text, table
 
 __all__ = ["erection_section", "write_erection_report"]
 
@@ -94,6 +94,7 @@ def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[
             title=caption,
             stress_unit="force/length",
             stress_scale=scale,
+            dpi=DPI,
         )
         out.append(figure(drawing, caption, f"figure-erection-{k}"))
     return out
@@ -149,7 +150,8 @@ def write_erection_report(result: ErectionResult, directory: Path, units: str) -
         status_text(result.converged, result.reason),
         [],
     )
-    parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
+    with drawing():
+        parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
     path = Path(directory) / "report.html"
     with atomic_path(path) as temporary:
         temporary.write_text("\n".join(parts), encoding="utf-8")
