@@ -200,16 +200,16 @@ def test_report_pictures_are_drawn_at_the_reports_resolution(tmp_path):
 def test_drawing_a_report_leaves_the_collector_as_it_found_it():
     import gc
 
-    from vares.app.html_parts import drawing
+    from vares.app.html_parts import report_drawing
 
     assert gc.get_freeze_count() == 0
-    with drawing():
+    with report_drawing():
         assert gc.get_freeze_count() > 0  # what was there before is left alone meanwhile
     assert gc.get_freeze_count() == 0
     gc.freeze()  # frozen by someone else: theirs, untouched
     try:
         frozen = gc.get_freeze_count()
-        with drawing():
+        with report_drawing():
             pass
         assert gc.get_freeze_count() == frozen
     finally:

@@ -14,6 +14,7 @@ from vares.io.plot import (
     pattern_image,
     plot_convergence,
     plot_pattern,
+    plot_pattern_fields,
     save_pattern_figure,
 )
 from vares.mechanics.fields import FIELD_DESCRIPTIONS
@@ -125,6 +126,30 @@ def test_a_shared_cell_image_draws_the_same_pictures_as_a_fresh_one():
         drawn = _png(plot_pattern(mesh, x, result.fields[name], image=shared, **style))
         assert drawn == alone
     assert np.array_equal(shared.index, index)
+
+
+def test_fields_drawn_on_one_figure_are_the_pictures_drawn_one_by_one():
+    """A centred and an uncentred scale, stresses and degrees, one after the other on one
+    figure: each picture is, byte for byte, plot_pattern's own; the figure is closed after."""
+    result = vares.solve(hypar(n=6), vares.materials.NeoHooke(1000.0, 0.3))
+    mesh, x = result.mesh, result.material_coordinates
+    names = ("det_F", "energy_density", "warp_stress", "shear_angle", "stress_min")
+    fields = {name: result.fields[name] for name in names}
+    style = {"fibres": result.fibres, "stress_scale": 1000.0, "stress_unit": "kPa"}
+    shared = pattern_image(mesh, x, dpi=100)
+    drawn, numbers = [], set()
+    for name, fig in plot_pattern_fields(mesh, x, fields, image=shared, **style):
+        drawn.append(name)
+        numbers.add(fig.number)
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png", dpi=100)
+        assert fig.axes[0].get_title() == name
+        assert fig.axes[1].get_ylabel() == FIELD_LABELS[name].replace("{stress}", "kPa")
+        alone = plot_pattern(mesh, x, fields[name], field=name, title=name, dpi=100, **style)
+        assert buffer.getvalue() == _png(alone)
+    assert drawn == list(names) and len(numbers) == 1  # one figure
+    assert not plt.fignum_exists(numbers.pop())  # closed at the end
+    assert list(plot_pattern_fields(mesh, x, {})) == []
 
 
 def test_cells_are_rasterised_at_the_resolution_the_picture_is_saved_at():

@@ -14,7 +14,16 @@ import numpy as np
 
 from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path
-from .html_parts import DPI, drawing, figure, number, page, picture, status_text, table
+from .html_parts import (
+    DPI,
+    figure,
+    number,
+    page,
+    picture,
+    report_drawing,
+    status_text,
+    table,
+)
 
 __all__ = ["erection_section", "write_erection_report"]
 
@@ -150,7 +159,7 @@ def write_erection_report(result: ErectionResult, directory: Path, units: str) -
         status_text(result.converged, result.reason),
         [],
     )
-    with drawing():
+    with report_drawing():
         parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
     path = Path(directory) / "report.html"
     with atomic_path(path) as temporary:

@@ -16,11 +16,11 @@ from .._version import __version__
 __all__ = [
     "DPI",
     "STYLE",
-    "drawing",
     "figure",
     "number",
     "page",
     "picture",
+    "report_drawing",
     "status_text",
     "table",
 ]
@@ -49,7 +49,7 @@ figcaption { font-size: 0.9em; color: #555; }
 
 
 @contextmanager
-def drawing() -> Iterator[None]:
+def report_drawing() -> Iterator[None]:
     """Around drawing a report: the garbage collector leaves the objects that were there before
     (modules, numba's type system: some 250,000) alone until the end. A report's figures are
     short-lived reference cycles, enough of them to set off a full collection, which walked all
@@ -65,18 +65,19 @@ def drawing() -> Iterator[None]:
         gc.unfreeze()
 
 
-def _png(fig) -> str:
+def _png(fig, close: bool) -> str:
     import matplotlib.pyplot as plt
 
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=DPI, pil_kwargs={"compress_level": _COMPRESS_LEVEL})
-    plt.close(fig)
+    if close:
+        plt.close(fig)
     return base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
-def figure(fig, caption: str, ident: str) -> str:
-    """A matplotlib figure, drawn and embedded (and closed)."""
-    return _embedded(_png(fig), caption, ident)
+def figure(fig, caption: str, ident: str, close: bool = True) -> str:
+    """A matplotlib figure, drawn and embedded (and closed, unless it is to be drawn again)."""
+    return _embedded(_png(fig, close), caption, ident)
 
 
 def picture(path: Path, caption: str, ident: str) -> str:

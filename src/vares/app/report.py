@@ -23,7 +23,16 @@ from ..materials import Hyperelastic
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
 from ..solver.linear import solver_choice
 from .erection_report import erection_section
-from .html_parts import DPI, drawing, figure, number, page, picture, status_text, table
+from .html_parts import (
+    DPI,
+    figure,
+    number,
+    page,
+    picture,
+    report_drawing,
+    status_text,
+    table,
+)
 from .job import Job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import units_of
@@ -152,7 +161,7 @@ def _convergence_section(result) -> list[str]:
 
 
 def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]:
-    from ..io.plot import pattern_image, plot_pattern, plot_surface
+    from ..io.plot import pattern_image, plot_pattern, plot_pattern_fields, plot_surface
 
     result, mesh, fields = outcome.result, outcome.mesh, outcome.result.fields
     x = result.material_coordinates
@@ -175,19 +184,17 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
             "figure-pattern",
         ),
     ]
-    for name in _FIGURE_FIELDS:
-        drawing = plot_pattern(
-            mesh,
-            x,
-            fields[name],
-            field=name,
-            fibres=result.fibres,
-            title=name,
-            stress_scale=scale,
-            image=image,
-        )
+    drawings = plot_pattern_fields(
+        mesh,
+        x,
+        {name: fields[name] for name in _FIGURE_FIELDS},
+        fibres=result.fibres,
+        stress_scale=scale,
+        image=image,
+    )
+    for name, drawing in drawings:
         caption = f"{name} on the pattern (on the design shape)"
-        parts.append(figure(drawing, caption, f"figure-{name}"))
+        parts.append(figure(drawing, caption, f"figure-{name}", close=False))
     surface_det_f = plot_surface(mesh, fields["det_F"], field="det_F", title="det F", dpi=DPI)
     surface_warp = plot_surface(
         mesh,
@@ -331,7 +338,7 @@ def _cut_section(outcome: JobOutcome) -> list[str]:
 def write_reports(outcome: JobOutcome) -> None:
     """Write each pattern's ``report.html`` (and the structure's), atomically; the paths go to
     the outcome's file lists."""
-    with drawing():
+    with report_drawing():
         for panel in outcome.panels:
             path = panel.directory / "report.html"
             _write_text(path, html_report(panel, outcome))
