@@ -15,6 +15,8 @@ from vares.io.plot import (
     plot_convergence,
     plot_pattern,
     plot_pattern_fields,
+    plot_surface,
+    plot_surface_fields,
     save_pattern_figure,
 )
 from vares.mechanics.fields import FIELD_DESCRIPTIONS
@@ -150,6 +152,28 @@ def test_fields_drawn_on_one_figure_are_the_pictures_drawn_one_by_one():
     assert drawn == list(names) and len(numbers) == 1  # one figure
     assert not plt.fignum_exists(numbers.pop())  # closed at the end
     assert list(plot_pattern_fields(mesh, x, {})) == []
+
+
+def test_surface_fields_drawn_on_one_figure_are_the_pictures_drawn_one_by_one():
+    """As for patterns: views of the surface re-coloured field after field (shaded, with mesh
+    lines and a centred scale after an uncentred one) are plot_surface's own, to the byte."""
+    result = vares.solve(hypar(n=6), vares.materials.NeoHooke(1000.0, 0.3))
+    mesh = result.mesh
+    names = ("energy", "det_F", "compressed_yarns", "fill_stress")
+    fields = {name: result.fields[name] for name in names}
+    titles = {name: f"{name} on the design surface" for name in names}
+    style = {"stress_scale": 1000.0, "stress_unit": "force/length", "dpi": 100}
+    drawn, numbers = [], set()
+    for name, fig in plot_surface_fields(mesh, fields, titles=titles, **style):
+        drawn.append(name)
+        numbers.add(fig.number)
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png", dpi=100)
+        assert fig.axes[0].get_title() == titles[name]
+        alone = plot_surface(mesh, fields[name], field=name, title=titles[name], **style)
+        assert buffer.getvalue() == _png(alone)
+    assert drawn == list(names) and len(numbers) == 1
+    assert not plt.fignum_exists(numbers.pop())
 
 
 def test_cells_are_rasterised_at_the_resolution_the_picture_is_saved_at():

@@ -161,7 +161,7 @@ def _convergence_section(result) -> list[str]:
 
 
 def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]:
-    from ..io.plot import pattern_image, plot_pattern, plot_pattern_fields, plot_surface
+    from ..io.plot import pattern_image, plot_pattern, plot_pattern_fields, plot_surface_fields
 
     result, mesh, fields = outcome.result, outcome.mesh, outcome.result.fields
     x = result.material_coordinates
@@ -195,21 +195,19 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
     for name, drawing in drawings:
         caption = f"{name} on the pattern (on the design shape)"
         parts.append(figure(drawing, caption, f"figure-{name}", close=False))
-    surface_det_f = plot_surface(mesh, fields["det_F"], field="det_F", title="det F", dpi=DPI)
-    surface_warp = plot_surface(
+    titles = {"det_F": "det F", "warp_stress": "warp stress"}
+    surfaces = plot_surface_fields(
         mesh,
-        fields["warp_stress"],
-        field="warp_stress",
-        title="warp stress",
+        {name: fields[name] for name in titles},
+        titles=titles,
         stress_scale=scale,
         dpi=DPI,
     )
-    return [
-        *parts,
-        "<h2>On the design surface</h2>",
-        figure(surface_det_f, "det F on the design surface", "figure-surface-det_F"),
-        figure(surface_warp, "warp stress on the design surface", "figure-surface-warp_stress"),
-    ]
+    parts.append("<h2>On the design surface</h2>")
+    for name, drawing in surfaces:
+        caption = f"{titles[name]} on the design surface"
+        parts.append(figure(drawing, caption, f"figure-surface-{name}", close=False))
+    return parts
 
 
 def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:

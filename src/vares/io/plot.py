@@ -7,7 +7,7 @@ decide where it goes (``fig.savefig("pattern.png")``).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import NamedTuple
 
 import matplotlib.pyplot as plt
@@ -34,6 +34,7 @@ __all__ = [
     "plot_pattern",
     "plot_pattern_fields",
     "plot_surface",
+    "plot_surface_fields",
     "save_pattern_figure",
 ]
 
@@ -258,21 +259,49 @@ def plot_pattern(
 
 
 class _Drawn(NamedTuple):
-    """A drawn pattern: its figure, the cells' image, and where values colour them, the image
-    drawn and its colour bar."""
+    """A drawn field: its figure, the image of the cells and its colour bar, and how per-cell
+    values in a colour scale become that image."""
 
     figure: plt.Figure
-    image: CellImage
-    picture: object | None
-    bar: object | None
+    picture: object
+    bar: object
+    paint: Callable[[ScalarMappable, np.ndarray], np.ndarray]
 
 
-def _field_colours(values, field, value_range, stress_scale, stress_unit):
-    """Per-cell values' colours (RGBA bytes), the colour scale they are drawn in and its label."""
+def _field_scale(values, field, value_range, stress_scale, stress_unit):
+    """The colour scale per-cell values are drawn in, and its label."""
     norm, cmap = _colour_scale(values, field, value_range, stress_scale)
-    shown = ScalarMappable(norm=norm, cmap=cmap)
     label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
-    return shown.to_rgba(values, bytes=True), shown, label
+    return ScalarMappable(norm=norm, cmap=cmap), label
+
+
+def _each_field(
+    fields: Mapping[str, np.ndarray],
+    titles: Mapping[str, str] | None,
+    draw: Callable[[str, np.ndarray, str], _Drawn],
+    stress_scale: float | None,
+    stress_unit: str,
+) -> Iterator[tuple[str, plt.Figure]]:
+    """Every field on one figure: the first ``draw``-n, each next re-colouring its cells and
+    colour bar and re-titling it; the figure closed at the end."""
+    drawn = None
+    try:
+        for name, values in fields.items():
+            values = np.asarray(values, dtype=float)
+            title = name if titles is None else titles[name]
+            if drawn is None:
+                drawn = draw(name, values, title)
+            else:
+                shown, label = _field_scale(values, name, None, stress_scale, stress_unit)
+                drawn.picture.set_data(drawn.paint(shown, values))
+                drawn.bar.mappable = shown
+                drawn.bar.update_normal()  # the new scale, its ticks and their labels
+                drawn.bar.set_label(label)
+                _title(drawn.figure.axes[0], title)
+            yield name, drawn.figure
+    finally:
+        if drawn is not None:
+            plt.close(drawn.figure)
 
 
 def _draw_pattern(
@@ -297,10 +326,8 @@ def _draw_pattern(
             ax.add_collection(lines)
     else:
         values = np.asarray(values, dtype=float)
-        colours, shown, label = _field_colours(
-            values, field, value_range, stress_scale, stress_unit
-        )
-        picture = _cells(ax, image, colours)
+        shown, label = _field_scale(values, field, value_range, stress_scale, stress_unit)
+        picture = _cells(ax, image, shown.to_rgba(values, bytes=True))
         if edges:
             lines = LineCollection(
                 coordinates[mesh.edges()], colors="k", linewidths=0.1, rasterized=True
@@ -325,7 +352,7 @@ def _draw_pattern(
     ax.set_aspect("equal")
     ax.autoscale_view()
     _title(ax, title)
-    return _Drawn(fig, image, picture, bar)
+    return _Drawn(fig, picture, bar, lambda shown, v: image.colours(shown.to_rgba(v, bytes=True)))
 
 
 def plot_pattern_fields(
@@ -345,29 +372,15 @@ def plot_pattern_fields(
     byte, :func:`plot_pattern`'s own of that field, for a quarter less work (a report draws
     five); but the figure is the same, so save it before taking the next. It is closed at the
     end."""
-    drawn = None
-    try:
-        for name, values in fields.items():
-            values = np.asarray(values, dtype=float)
-            if drawn is None:
-                drawn = _draw_pattern(
-                    mesh, coordinates, values, field=name, ax=None, fibres=fibres, title=name,
-                    stress_unit=stress_unit, value_range=None, edges=False,
-                    stress_scale=stress_scale, marks=None, dpi=dpi, image=image,
-                )  # fmt: skip
-            else:
-                colours, shown, label = _field_colours(
-                    values, name, None, stress_scale, stress_unit
-                )
-                drawn.picture.set_data(drawn.image.colours(colours))
-                drawn.bar.mappable = shown
-                drawn.bar.update_normal()  # the new scale, its ticks and their labels
-                drawn.bar.set_label(label)
-                _title(drawn.figure.axes[0], name)
-            yield name, drawn.figure
-    finally:
-        if drawn is not None:
-            plt.close(drawn.figure)
+
+    def draw(name: str, values: np.ndarray, title: str) -> _Drawn:
+        return _draw_pattern(
+            mesh, coordinates, values, field=name, ax=None, fibres=fibres, title=title,
+            stress_unit=stress_unit, value_range=None, edges=False, stress_scale=stress_scale,
+            marks=None, dpi=dpi, image=image,
+        )  # fmt: skip
+
+    return _each_field(fields, None, draw, stress_scale, stress_unit)
 
 
 def save_pattern_figure(path, *args, dpi: float = DPI, **kwargs) -> None:
@@ -389,11 +402,19 @@ class _SurfaceView:
         facing = mesh.area_vectors() @ view.axes()[2]
         self.shade = 0.55 + 0.45 * np.abs(facing) / np.maximum(mesh.cell_areas(), 1e-300)
 
-    def cells(self, colours: np.ndarray) -> None:
-        """Per-cell RGBA colours ``(cells, 4)``, shaded."""
+    def shaded(self, colours: np.ndarray) -> np.ndarray:
+        """Per-cell RGBA colours ``(cells, 4)``, floats, shaded, as bytes."""
         shaded = np.array(colours, dtype=float)
         shaded[:, :3] *= self.shade[:, None]
-        _cells(self.ax, self.image, _bytes(shaded))
+        return _bytes(shaded)
+
+    def cells(self, colours: np.ndarray):
+        """Per-cell RGBA colours ``(cells, 4)``, shaded: the image drawn."""
+        return _cells(self.ax, self.image, self.shaded(colours))
+
+    def paint(self, shown: ScalarMappable, values: np.ndarray) -> np.ndarray:
+        """Per-cell values in the colour scale ``shown``: the image of the cells, shaded."""
+        return self.image.colours(self.shaded(shown.to_rgba(values)))
 
     def lines(self, segments: np.ndarray, **style) -> None:
         """Node pairs ``(k, 2)`` drawn where they are seen (tested at their ends and middle)."""
@@ -447,25 +468,55 @@ def plot_surface(
     """A view of the surface (``view``: from 30° above, azimuth −60°, as matplotlib's 3D axes),
     optionally coloured by per-cell ``values``; hidden cells stay hidden (depth buffer). The
     cells are rasterised for the figure saved at ``dpi``."""
+    return _draw_surface(mesh, values, field, ax, title, stress_unit, stress_scale, view, dpi)[0]
+
+
+def _draw_surface(
+    mesh, values, field, ax, title, stress_unit, stress_scale, view, dpi
+) -> tuple[plt.Figure, _Drawn | None]:
+    """:func:`plot_surface`, with what a next field re-colours (where values colour it)."""
     view = view or View()
     if ax is None:
         fig, ax = _figure(_view_size(mesh, view, 7.0, 5.2))
     fig = ax.figure
     seen = _SurfaceView(mesh, ax, view, dpi)
+    drawn = None
     if values is None:
         seen.cells(np.tile(to_rgba(_FACE), (mesh.num_cells, 1)))
     else:
         values = np.asarray(values, dtype=float)
-        norm, cmap = _colour_scale(values, field, None, stress_scale)
-        mappable = ScalarMappable(norm=norm, cmap=cmap)
-        seen.cells(mappable.to_rgba(values))
-        label = FIELD_LABELS.get(field, field or "").replace("{stress}", stress_unit)
-        fig.colorbar(mappable, ax=ax, label=label, shrink=0.7)
+        shown, label = _field_scale(values, field, None, stress_scale, stress_unit)
+        picture = seen.cells(shown.to_rgba(values))
+        bar = fig.colorbar(shown, ax=ax, label=label, shrink=0.7)
+        drawn = _Drawn(fig, picture, bar, seen.paint)
     if mesh.num_cells <= MESH_LINES_UP_TO:
         seen.lines(mesh.edges(), colors=(0.25, 0.25, 0.25, 0.35), linewidths=0.15, rasterized=True)
     seen.lines(mesh.boundary_edges(), colors="k", linewidths=0.6)
     seen.finish(title)
-    return fig
+    return fig, drawn
+
+
+def plot_surface_fields(
+    mesh: SurfaceMesh,
+    fields: Mapping[str, np.ndarray],
+    *,
+    titles: Mapping[str, str] | None = None,
+    stress_unit: str = "stress",
+    stress_scale: float | None = None,
+    view: View | None = None,
+    dpi: float = DPI,
+) -> Iterator[tuple[str, plt.Figure]]:
+    """:func:`plot_surface` of each of ``fields`` (name → per-cell values) in turn, titled by
+    ``titles`` (by name; else the name), as ``(name, figure)``: one figure, its cells
+    rasterised, its lines and colour bar made once, that each field re-colours. Each picture
+    is, to the byte, :func:`plot_surface`'s own; the figure is the same, so save it before
+    taking the next. It is closed at the end."""
+
+    def draw(name: str, values: np.ndarray, title: str) -> _Drawn:
+        args = (name, None, title, stress_unit, stress_scale, view, dpi)
+        return _draw_surface(mesh, values, *args)[1]
+
+    return _each_field(fields, titles, draw, stress_scale, stress_unit)
 
 
 def plot_convergence(history, ax=None, title: str | None = "convergence") -> plt.Figure:
