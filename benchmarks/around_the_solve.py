@@ -7,7 +7,8 @@ Every run is a fresh `vares pattern FILE -o DIR --force` process (compiled kerne
 disk, as after the first run of an install), in three variants: `--no-previews`, the default
 (SVG and PNG previews) and `--report`. Prints the median wall time of the whole process, the
 solve's own time (``elapsed_seconds`` + ``warm_up_seconds`` of summary.json) and what the
-report adds.
+report adds. The command is the ``vares`` script on PATH, which imports the package from
+PYTHONPATH first: ``PYTHONPATH=src`` measures this tree's code.
 """
 
 from __future__ import annotations

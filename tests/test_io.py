@@ -167,6 +167,55 @@ def test_rhino_files_without_meshes(tmp_path):
         read_3dm(broken)
 
 
+def test_report_pictures_are_drawn_at_the_reports_resolution(tmp_path):
+    """The report's own pictures are PNGs at its 100 dpi (a 6.5-inch field map is 650 pixels
+    wide, a 7-inch view 700) whose cells are opaque colours, not the 150-dpi files'; the pattern
+    is the run's own pattern.png, embedded as it is."""
+    import base64
+    import gc
+    import io
+    import re
+
+    from PIL import Image
+
+    out = tmp_path / "hypar"
+    result = run("example", "hypar", "-o", out, "--report", "-q")
+    assert result.exit_code == 0, result.stderr
+    assert gc.get_freeze_count() == 0  # the collector as the report found it
+    text = (out / "report.html").read_text()
+    embedded = r'<figure id="([^"]+)"><img alt="[^"]*" src="data:image/png;base64,([^"]+)"'
+    found = re.findall(embedded, text)
+    pictures = {ident: Image.open(io.BytesIO(base64.b64decode(data))) for ident, data in found}
+    assert set(pictures) >= {"figure-convergence", "figure-pattern", "figure-det_F"}
+    for ident in ("figure-det_F", "figure-warp_stress", "figure-shear_angle", "figure-stress_min"):
+        assert pictures[ident].size[0] == 650
+        centre = pictures[ident].convert("RGBA").getpixel((300, pictures[ident].size[1] // 2))
+        assert centre[3] == 255 and centre[:3] != (255, 255, 255)  # a cell's colour
+    for ident in ("figure-convergence", "figure-surface-det_F", "figure-surface-warp_stress"):
+        assert pictures[ident].size[0] == 700
+    pattern = base64.b64encode((out / "pattern.png").read_bytes()).decode("ascii")
+    assert dict(found)["figure-pattern"] == pattern
+
+
+def test_drawing_a_report_leaves_the_collector_as_it_found_it():
+    import gc
+
+    from vares.app.html_parts import report_drawing
+
+    assert gc.get_freeze_count() == 0
+    with report_drawing():
+        assert gc.get_freeze_count() > 0  # what was there before is left alone meanwhile
+    assert gc.get_freeze_count() == 0
+    gc.freeze()  # frozen by someone else: theirs, untouched
+    try:
+        frozen = gc.get_freeze_count()
+        with report_drawing():
+            pass
+        assert gc.get_freeze_count() == frozen
+    finally:
+        gc.unfreeze()
+
+
 def test_pattern_outputs_drawings_and_report_in_a_browser(tmp_path):
     out = tmp_path / "sail"
     result = run(

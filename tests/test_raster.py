@@ -63,17 +63,48 @@ def test_surface_view_draws_the_cells_it_sees():
     values = np.linspace(0.0, 1.0, mesh.num_cells)
     view = View(elevation=89.0)
     fig = plot_surface(mesh, values, field="energy", view=view)
-    rgba = np.asarray(fig.axes[0].images[0].get_array())
+    drawn = fig.axes[0].images[0]
+    rgba = np.asarray(drawn.get_array())
+    assert rgba.dtype == np.uint8
     assert fig.axes[1].get_ylabel() == "strain energy"  # the colour bar
     plt.close(fig)
-    image = rasterise(mesh.cells, *view.project(mesh.points))  # the same drawing's cells
+    screen, depth = view.project(mesh.points)
+    x0, x1, _, _ = drawn.get_extent()
+    pixels = round(np.ptp(screen, axis=0).max() * rgba.shape[1] / (x1 - x0))
+    image = rasterise(mesh.cells, screen, depth, pixels=pixels)  # the same drawing's cells
+    assert image.index.shape == rgba.shape[:2]
+    assert image.extent == pytest.approx(drawn.get_extent())
     shown = image.index >= 0
     assert set(np.unique(image.index[shown])) == set(range(mesh.num_cells))
-    assert np.all(rgba[~shown, 3] == 0) and np.all(rgba[shown, 3] == 1)
-    expected = colormaps["viridis"](values)[image.index[shown], :3]  # energy: 0 … 1, viridis
-    ratio = rgba[shown, :3] / expected
-    assert np.all(ratio >= 0.55 - 1e-12) and np.all(ratio <= 1 + 1e-12)
-    assert np.ptp(ratio, axis=1).max() < 1e-12  # one shade per pixel: the colour's own hue
+    assert np.all(rgba[~shown] == 0) and np.all(rgba[shown, 3] == 255)
+    expected = 255 * colormaps["viridis"](values)[image.index[shown], :3]  # energy: viridis
+    colour = rgba[shown, :3].astype(float)
+    shade = np.sum(colour * expected, axis=1) / np.sum(expected * expected, axis=1)
+    assert np.all(shade >= 0.55 - 0.01) and np.all(shade <= 1 + 0.01)
+    # one shade per pixel: the colour's own hue, to a byte's rounding
+    assert np.abs(colour - shade[:, None] * expected).max() <= 1.0
+
+
+def test_cell_colours_fill_their_pixels_and_leave_the_rest_transparent():
+    """Two triangles of a unit square, one red, one blue (bytes or floats): a pixel inside each
+    has its colour, of the same type, and the margin around them is transparent."""
+    points, cells = _square(0.0)
+    image = rasterise({"triangle": cells}, points[:, :2], pixels=50)
+    x0, _, y0, _ = image.extent
+
+    def at(x: float, y: float) -> tuple[int, int]:
+        return int((y - y0) / image.pixel), int((x - x0) / image.pixel)
+
+    below, above = at(0.8, 0.2), at(0.2, 0.8)  # under the diagonal (0, 2) and over it
+    for colours in (
+        np.array([[255, 0, 0, 255], [0, 0, 255, 255]], dtype=np.uint8),
+        np.array([[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.5]]),
+    ):
+        rgba = image.colours(colours)
+        assert rgba.dtype == colours.dtype and rgba.shape == (*image.index.shape, 4)
+        assert np.array_equal(rgba[below], colours[0]) and np.array_equal(rgba[above], colours[1])
+        assert np.all(rgba[image.index < 0] == 0) and np.all(rgba[0] == 0)
+        assert np.array_equal(rgba[image.index >= 0], colours[image.index[image.index >= 0]])
 
 
 def test_a_drawing_no_pixel_centre_falls_in_is_empty_not_an_error():
@@ -81,3 +112,4 @@ def test_a_drawing_no_pixel_centre_falls_in_is_empty_not_an_error():
     image = rasterise({"triangle": np.array([[0, 1, 2]])}, sliver)
     assert np.all(image.index == -1)
     assert image.lookup(np.array([3.0])).mask.all()
+    assert not image.colours(np.array([[9, 9, 9, 255]], dtype=np.uint8)).any()

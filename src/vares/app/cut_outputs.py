@@ -189,7 +189,9 @@ def _lines_figure(outcome: JobOutcome):
 def _write_figure(path, figure, close: bool = True) -> None:
     import matplotlib.pyplot as plt
 
+    from ..io.plot import DPI
+
     with atomic_path(path) as temporary:
-        figure.savefig(temporary, dpi=150)
+        figure.savefig(temporary, dpi=DPI)
     if close:
         plt.close(figure)

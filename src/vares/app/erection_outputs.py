@@ -40,9 +40,7 @@ def erection_files(directory: Path, report: bool = False) -> list[Path]:
 
 def write_erection(result: ErectionResult, directory: Path, units: str) -> list[Path]:
     """The files of an erection (:data:`ERECTION_FILES`) in ``directory``; returns their paths."""
-    import matplotlib.pyplot as plt
-
-    from ..io.plot import plot_surface
+    from ..io.plot import DPI, plot_surface_fields
 
     files = []
     fields = dict(result.fields) | {f"design_{k}": v for k, v in result.design_fields.items()}
@@ -66,23 +64,22 @@ def write_erection(result: ErectionResult, directory: Path, units: str) -> list[
         [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
     )
     scale = result.material.stiffness_scale * result.thickness
-    drawings = {
-        "deviation.png": (per_cell, "normal_deviation", f"normal deviation ({units})"),
-        "warp_stress.png": (result.fields["warp_stress"], "warp_stress", "warp force, erected"),
-        "fill_stress.png": (result.fields["fill_stress"], "fill_stress", "fill force, erected"),
-        "state.png": (result.fields["state"], "state", "taut / wrinkled / slack, erected"),
+    drawings = {  # field: file, values, title
+        "normal_deviation": ("deviation.png", per_cell, f"normal deviation ({units})"),
+        "warp_stress": ("warp_stress.png", result.fields["warp_stress"], "warp force, erected"),
+        "fill_stress": ("fill_stress.png", result.fields["fill_stress"], "fill force, erected"),
+        "state": ("state.png", result.fields["state"], "taut / wrinkled / slack, erected"),
     }
-    for name, (values, field, title) in drawings.items():
-        fig = plot_surface(
-            erected,
-            values,
-            field=field,
-            title=title,
-            stress_unit="force/length",
-            stress_scale=scale,
-        )
-        with atomic_path(directory / name) as temporary:
-            fig.savefig(temporary, dpi=150)
-        plt.close(fig)
-        files.append(directory / name)
+    pictures = plot_surface_fields(  # on one figure
+        erected,
+        {field: values for field, (_, values, _) in drawings.items()},
+        titles={field: title for field, (_, _, title) in drawings.items()},
+        stress_unit="force/length",
+        stress_scale=scale,
+    )
+    for field, fig in pictures:
+        path = directory / drawings[field][0]
+        with atomic_path(path) as temporary:
+            fig.savefig(temporary, dpi=DPI)
+        files.append(path)
     return files

@@ -14,7 +14,16 @@ import numpy as np
 
 from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path
-from .html_parts import figure, number, page, picture, status_text, table
+from .html_parts import (
+    DPI,
+    figure,
+    number,
+    page,
+    picture,
+    report_drawing,
+    status_text,
+    table,
+)
 
 __all__ = ["erection_section", "write_erection_report"]
 
@@ -63,8 +72,9 @@ def _comparison_rows(result: ErectionResult, units: str) -> list[tuple[str, str,
 
 
 def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[str]:
-    """The section's pictures; those the erection wrote into ``pictures`` are embedded."""
-    from ..io.plot import plot_surface
+    """The section's pictures; those the erection wrote into ``pictures`` are embedded, the
+    others drawn, those of each shape on one figure (:func:`~vares.io.plot.plot_surface_fields`)."""
+    from ..io.plot import plot_surface_fields
 
     erected = result.erected_mesh
     scale = result.material.stiffness_scale * result.thickness
@@ -73,29 +83,41 @@ def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[
     )
     design, after = result.design_fields, result.fields
     drawings = [  # the file an erection writes of the same picture, if it writes one
-        ("deviation.png", erected, per_cell, "normal_deviation", "normal deviation from design"),
-        (None, result.mesh, design["warp_stress"], "warp_stress", "warp force on the design shape"),
-        ("warp_stress.png", erected, after["warp_stress"], "warp_stress", "warp force, erected"),
-        (None, result.mesh, design["fill_stress"], "fill_stress", "fill force on the design shape"),
-        ("fill_stress.png", erected, after["fill_stress"], "fill_stress", "fill force, erected"),
-        ("state.png", erected, after["state"], "state", "taut (0) / wrinkled (1) / slack (2)"),
+        ("deviation.png", "erected", per_cell, "normal_deviation", "normal deviation from design"),
+        (None, "design", design["warp_stress"], "warp_stress", "warp force on the design shape"),
+        ("warp_stress.png", "erected", after["warp_stress"], "warp_stress", "warp force, erected"),
+        (None, "design", design["fill_stress"], "fill_stress", "fill force on the design shape"),
+        ("fill_stress.png", "erected", after["fill_stress"], "fill_stress", "fill force, erected"),
+        ("state.png", "erected", after["state"], "state", "taut (0) / wrinkled (1) / slack (2)"),
     ]  # fmt: skip
-    out = []
-    for k, (name, mesh, values, field, caption) in enumerate(drawings):
+    embedded, fields, titles = {}, {"design": {}, "erected": {}}, {"design": {}, "erected": {}}
+    for k, (name, shape, values, field, caption) in enumerate(drawings):
         if name == "deviation.png":
             caption = f"{caption} ({units})"
         if pictures is not None and name is not None and (pictures / name).is_file():
-            out.append(picture(pictures / name, caption, f"figure-erection-{k}"))
-            continue
-        drawing = plot_surface(
+            embedded[k] = picture(pictures / name, caption, f"figure-erection-{k}")
+        else:  # a shape's fields are distinct
+            fields[shape][field], titles[shape][field] = values, caption
+    drawn = {
+        shape: plot_surface_fields(
             mesh,
-            values,
-            field=field,
-            title=caption,
+            fields[shape],
+            titles=titles[shape],
             stress_unit="force/length",
             stress_scale=scale,
+            dpi=DPI,
         )
-        out.append(figure(drawing, caption, f"figure-erection-{k}"))
+        for shape, mesh in (("design", result.mesh), ("erected", erected))
+    }
+    out = []
+    for k, (_, shape, _, field, _) in enumerate(drawings):
+        if k in embedded:
+            out.append(embedded[k])
+            continue
+        _, drawing = next(drawn[shape])  # the pictures of a shape come in the order asked
+        out.append(figure(drawing, titles[shape][field], f"figure-erection-{k}", close=False))
+    for pictures_of_a_shape in drawn.values():
+        pictures_of_a_shape.close()  # and its figure
     return out
 
 
@@ -149,7 +171,8 @@ def write_erection_report(result: ErectionResult, directory: Path, units: str) -
         status_text(result.converged, result.reason),
         [],
     )
-    parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
+    with report_drawing():
+        parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
     path = Path(directory) / "report.html"
     with atomic_path(path) as temporary:
         temporary.write_text("\n".join(parts), encoding="utf-8")

@@ -4,13 +4,34 @@ from __future__ import annotations
 
 import base64
 import datetime
+import gc
 import html
 import io
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from .._version import __version__
 
-__all__ = ["STYLE", "figure", "number", "page", "picture", "status_text", "table"]
+__all__ = [
+    "DPI",
+    "STYLE",
+    "figure",
+    "number",
+    "page",
+    "picture",
+    "report_drawing",
+    "status_text",
+    "table",
+]
+
+#: Resolution of the pictures drawn into a report (a 6.5-inch figure is 650 pixels wide, shown at
+#: most 520): pass it to the plots, which rasterise the cells for it.
+DPI = 100
+#: zlib level of the embedded PNGs. A 100k-cell field on the pattern at 100 dpi, level 6
+#: (Pillow's default) → 4 → 1: 41 → 20 → 15 ms, 157 → 171 → 203 KiB; a 4.6k-cell one 17 → 14 →
+#: 11 ms, 89 → 94 → 111 KiB. Level 4 takes most of the time off for a file 5–9 % larger.
+_COMPRESS_LEVEL = 4
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
@@ -27,18 +48,36 @@ figcaption { font-size: 0.9em; color: #555; }
 """
 
 
-def _png(fig) -> str:
+@contextmanager
+def report_drawing() -> Iterator[None]:
+    """Around drawing a report: the garbage collector leaves the objects that were there before
+    (modules, numba's type system: some 250,000) alone until the end. A report's figures are
+    short-lived reference cycles, enough of them to set off a full collection, which walked all
+    of those: 0.12 s of a report. Where something else has frozen objects already, nothing
+    changes."""
+    if gc.get_freeze_count():
+        yield
+        return
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
+
+
+def _png(fig, close: bool) -> str:
     import matplotlib.pyplot as plt
 
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100)
-    plt.close(fig)
+    fig.savefig(buffer, format="png", dpi=DPI, pil_kwargs={"compress_level": _COMPRESS_LEVEL})
+    if close:
+        plt.close(fig)
     return base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
-def figure(fig, caption: str, ident: str) -> str:
-    """A matplotlib figure, drawn and embedded (and closed)."""
-    return _embedded(_png(fig), caption, ident)
+def figure(fig, caption: str, ident: str, close: bool = True) -> str:
+    """A matplotlib figure, drawn and embedded (and closed, unless it is to be drawn again)."""
+    return _embedded(_png(fig, close), caption, ident)
 
 
 def picture(path: Path, caption: str, ident: str) -> str:

@@ -228,7 +228,7 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
         return  # matplotlib is not even imported
     import matplotlib.pyplot as plt
 
-    from ..io.plot import plot_pattern, plot_surface
+    from ..io.plot import DPI, plot_pattern, plot_surface
 
     result, mesh = panel.result, panel.mesh
     x = result.material_coordinates
@@ -238,7 +238,7 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
         for name in names:
             path = panel.directory / name
             with atomic_path(path) as temporary:
-                fig.savefig(temporary, dpi=150)
+                fig.savefig(temporary, dpi=DPI)
             panel.files.append(path)
         plt.close(fig)
 

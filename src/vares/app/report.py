@@ -23,7 +23,16 @@ from ..materials import Hyperelastic
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
 from ..solver.linear import solver_choice
 from .erection_report import erection_section
-from .html_parts import figure, number, page, picture, status_text, table
+from .html_parts import (
+    DPI,
+    figure,
+    number,
+    page,
+    picture,
+    report_drawing,
+    status_text,
+    table,
+)
 from .job import Job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import units_of
@@ -152,10 +161,11 @@ def _convergence_section(result) -> list[str]:
 
 
 def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]:
-    from ..io.plot import plot_pattern, plot_surface
+    from ..io.plot import pattern_image, plot_pattern, plot_pattern_fields, plot_surface_fields
 
     result, mesh, fields = outcome.result, outcome.mesh, outcome.result.fields
     x = result.material_coordinates
+    image = pattern_image(mesh, x, DPI)  # the cells rasterised once for every picture of x
     scale = material.stiffness_scale * result.thickness
     crossings = None if result.overlap is None else result.overlap.crossings
     caption = "the pattern with warp and fill"
@@ -167,27 +177,37 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
         picture(preview, caption, "figure-pattern")
         if preview.is_file()
         else figure(
-            plot_pattern(mesh, x, fibres=result.fibres, title="pattern", marks=crossings),
+            plot_pattern(
+                mesh, x, fibres=result.fibres, title="pattern", marks=crossings, image=image
+            ),
             caption,
             "figure-pattern",
         ),
     ]
-    for name in _FIGURE_FIELDS:
-        drawing = plot_pattern(
-            mesh, x, fields[name], field=name, fibres=result.fibres, title=name, stress_scale=scale
-        )
-        caption = f"{name} on the pattern (on the design shape)"
-        parts.append(figure(drawing, caption, f"figure-{name}"))
-    surface_det_f = plot_surface(mesh, fields["det_F"], field="det_F", title="det F")
-    surface_warp = plot_surface(
-        mesh, fields["warp_stress"], field="warp_stress", title="warp stress", stress_scale=scale
+    drawings = plot_pattern_fields(
+        mesh,
+        x,
+        {name: fields[name] for name in _FIGURE_FIELDS},
+        fibres=result.fibres,
+        stress_scale=scale,
+        image=image,
     )
-    return [
-        *parts,
-        "<h2>On the design surface</h2>",
-        figure(surface_det_f, "det F on the design surface", "figure-surface-det_F"),
-        figure(surface_warp, "warp stress on the design surface", "figure-surface-warp_stress"),
-    ]
+    for name, drawing in drawings:
+        caption = f"{name} on the pattern (on the design shape)"
+        parts.append(figure(drawing, caption, f"figure-{name}", close=False))
+    titles = {"det_F": "det F", "warp_stress": "warp stress"}
+    surfaces = plot_surface_fields(
+        mesh,
+        {name: fields[name] for name in titles},
+        titles=titles,
+        stress_scale=scale,
+        dpi=DPI,
+    )
+    parts.append("<h2>On the design surface</h2>")
+    for name, drawing in surfaces:
+        caption = f"{titles[name]} on the design surface"
+        parts.append(figure(drawing, caption, f"figure-surface-{name}", close=False))
+    return parts
 
 
 def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
@@ -305,7 +325,7 @@ def _cut_section(outcome: JobOutcome) -> list[str]:
             ("yield", f"{100 * nest.yield_:.1f} % (waste {100 * nest.waste:.1f} %)"),
         ]
     parts = ["<h2>Cutting and nesting</h2>", table(key, ident="cut-figures")]
-    lines = plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines)
+    lines = plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines, dpi=DPI)
     parts.append(figure(lines, "cutting lines on the surface", "cut-lines"))
     if nest is not None:
         drawing = plot_nest(nest.roll_width, nest.length, nested_drawings(outcome), units=units)
@@ -316,15 +336,16 @@ def _cut_section(outcome: JobOutcome) -> list[str]:
 def write_reports(outcome: JobOutcome) -> None:
     """Write each pattern's ``report.html`` (and the structure's), atomically; the paths go to
     the outcome's file lists."""
-    for panel in outcome.panels:
-        path = panel.directory / "report.html"
-        _write_text(path, html_report(panel, outcome))
-        panel.files.append(path)
-        outcome.files.append(path)
-    if outcome.structure is not None:
-        path = outcome.directory / "report.html"
-        _write_text(path, structure_report(outcome))
-        outcome.files.append(path)
+    with report_drawing():
+        for panel in outcome.panels:
+            path = panel.directory / "report.html"
+            _write_text(path, html_report(panel, outcome))
+            panel.files.append(path)
+            outcome.files.append(path)
+        if outcome.structure is not None:
+            path = outcome.directory / "report.html"
+            _write_text(path, structure_report(outcome))
+            outcome.files.append(path)
 
 
 def _write_text(path: Path, text: str) -> None:

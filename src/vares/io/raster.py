@@ -3,9 +3,13 @@
 Matplotlib draws a mesh polygon by polygon: about a second per picture of 100k cells, most of
 a report's cost; and its 3D axes sort the cells by depth instead of testing it, so hidden cells
 can show through. Here the cells are rasterised once into an index image — with a depth buffer
-for a view of the surface — and a picture of a per-cell field is a lookup through that image
-(``values[index]``), drawn with ``imshow``. Lines (outline, mesh lines, cutting lines) stay
-vectors on top; in a view of the surface they are kept where the depth buffer sees them.
+for a view of the surface — and a picture of a per-cell field is a lookup through that image:
+each cell's colour, mapped once per cell, is copied to its pixels (``colours[index]``) and the
+finished RGBA image is drawn with ``imshow`` (matplotlib then has no values to normalise,
+colour-map and resample per pixel). An image is best rasterised at the resolution it is shown at
+(``pixels``): one the size of the axes where the figure is saved. Lines (outline, mesh lines,
+cutting lines) stay vectors on top; in a view of the surface they are kept where the depth buffer
+sees them.
 """
 
 from __future__ import annotations
@@ -19,7 +23,8 @@ from numba import njit
 
 __all__ = ["CellImage", "View", "rasterise", "triangles_of"]
 
-#: Pixels along the longer side of a cell image (a 6.5-inch figure at 150 dpi is 975 wide).
+#: Pixels along the longer side of a cell image unless told (a 6.5-inch figure at 150 dpi is 975
+#: wide).
 PIXELS = 1000
 
 
@@ -65,6 +70,13 @@ class CellImage:
         image = np.asarray(per_cell)[np.where(inside, self.index, 0)]
         mask = ~inside if image.ndim == 2 else np.broadcast_to(~inside[..., None], image.shape)
         return np.ma.MaskedArray(image, mask=mask)
+
+    def colours(self, per_cell: np.ndarray) -> np.ndarray:
+        """Per-cell colours ``(cells, 4)`` (RGBA, floats or bytes) as an image
+        ``(rows, columns, 4)`` of the same type, transparent (all zero) where no cell shows."""
+        per_cell = np.asarray(per_cell)
+        table = np.concatenate([per_cell, np.zeros((1, per_cell.shape[1]), per_cell.dtype)])
+        return table[self.index]  # no cell (−1): the table's last row, transparent
 
     def seen(self, points: np.ndarray, depth: np.ndarray, slack: float = 3.0) -> np.ndarray:
         """Which of ``points`` (drawing coordinates, with their ``depth``) the view shows: no
