@@ -244,7 +244,13 @@ class _Run:
             steps=self.steps,
             callback=self.callback,
             constraint=constraint,
+            turning_about=_held_node(free) if rotation == "free" else None,
         )
+
+
+def _held_node(free: np.ndarray) -> int:
+    """The node whose translation is held (both its dofs fixed)."""
+    return int(np.flatnonzero(~free.reshape(-1, 2).any(axis=1))[0])
 
 
 def _folded_start(problem: Problem, start: Start) -> str | None:

@@ -22,6 +22,7 @@ class IterationRecord:
 
     ``damping`` is the damping coefficient used to reach this state, ``step_length`` the line
     search's step length and ``tangent`` the matrix of that step (``"exact"``, ``"projected"``
+    — ``"projected, turned"`` when a pattern free to turn was turned further than the step —
     or ``"damped"``); the last three are 0 or empty at iteration 0. ``factorisations`` and
     ``cg_iterations`` count the linear solver's work since the record before: numeric
     factorisations and conjugate-gradient iterations preconditioned by an earlier
