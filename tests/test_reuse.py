@@ -178,3 +178,20 @@ def test_globalised_newton_takes_the_projected_tangent_where_the_exact_one_is_re
     tangents = {r.tangent for r in result.history[1:]}
     assert "projected" in tangents
     assert result.energy == pytest.approx(reference.energy, rel=1e-10)
+
+
+def test_the_command_shows_and_reports_the_linear_work(tmp_path):
+    import json
+
+    from conftest import run
+
+    out = tmp_path / "out"
+    result = run("example", "hypar", "-o", out, "--linear-solver", "scipy-superlu", "--report")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["factorisations"] >= 1 and summary["cg_iterations"] > 0
+    shown = [line for line in result.stderr.splitlines() if " CG)" in line]
+    assert shown and len(shown) == sum(1 for h in summary["history"] if h["cg_iterations"])
+    report = (out / "report.html").read_text()
+    expected = f"{summary['factorisations']}, {summary['cg_iterations']}"
+    assert f'<th>factorisations, CG iterations</th><td class="num">{expected}</td>' in report

@@ -92,6 +92,10 @@ def _key_figures(outcome: PanelOutcome, unit_names: dict[str, str]) -> list[str]
         ("strategy", " → ".join(result.strategy)),
         ("initial guess", result.initial_guess),
         ("linear solver", solver_choice(result.options.linear_solver, result.linear_solver)),
+        (
+            "factorisations, CG iterations",
+            f"{result.factorisations}, {result.cg_iterations}",
+        ),
         ("time", _time(result)),
     ]
     parts = ["<h2>Key figures</h2>", table(key, ident="key-figures")]

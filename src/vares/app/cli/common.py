@@ -68,6 +68,8 @@ def progress(quiet: bool) -> Callable[[IterationRecord], None] | None:
 
     def show(record: IterationRecord) -> None:
         extra = f"  α={record.step_length:.3g} {record.tangent}" if record.iteration else ""
+        if record.cg_iterations:  # a step solved with an earlier factorisation
+            extra += f" ({record.cg_iterations} CG)"
         console.print(
             f"  {record.strategy:<18} step {record.step:>2}  τ={record.tau:6.4f}  "
             f"it {record.iteration:>2}  residual {record.relative_residual:9.3e}  "
