@@ -195,3 +195,44 @@ def test_the_command_shows_and_reports_the_linear_work(tmp_path):
     report = (out / "report.html").read_text()
     expected = f"{summary['factorisations']}, {summary['cg_iterations']}"
     assert f'<th>factorisations, CG iterations</th><td class="num">{expected}</td>' in report
+
+
+def test_constrained_cg_keeps_the_constraint_and_solves_the_bordered_system():
+    matrix = _laplacian(12)
+    n = matrix.shape[0]
+    rng = np.random.default_rng(7)
+    c = rng.standard_normal(n)
+    c /= np.linalg.norm(c)
+    rhs = rng.standard_normal(n)
+    rhs -= c * (c @ rhs)  # a Newton residual less its constraint component
+    later = (matrix + sp.diags(rng.uniform(0.0, 0.05, n))).tocsr()
+    solver = ReusingSolver(linear.get_solver("scipy-superlu"))
+    solver.solve(matrix, rhs, rtol=1e-3, constraint=c)  # factorises the bordered matrix
+    assert solver.factorisations == 1
+    x = solver.solve(later, rhs, rtol=1e-10, constraint=c)
+    assert solver.factorisations == 1 and solver.cg_iterations > 0
+    column = sp.csr_matrix(c[:, None])
+    bordered = sp.bmat([[later, column], [column.T, None]], format="csc")
+    exact = sp.linalg.spsolve(bordered, np.append(rhs, 0.0))[:-1]
+    assert abs(c @ x) < 1e-12 * np.linalg.norm(x)
+    np.testing.assert_allclose(x, exact, atol=1e-8 * np.linalg.norm(exact))
+
+
+def test_a_held_anisotropic_solve_reuses_its_bordered_factorisation():
+    """Orthotropic fabric, rotation held (the tangent bordered by the rotation constraint):
+    SuperLU factorises once and reaches exact Newton's pattern."""
+    mesh = examples.hypar(size=10.0, rise=0.06, n=24)
+    law = vares.materials.OrthotropicStVenantKirchhoff(800.0, 640.0, 40.0, 0.4)
+    inexact = vares.solve(mesh, law, warp_angle=20.0, linear_solver="scipy-superlu")
+    exact = (
+        vares.solve(mesh, law, warp_angle=20.0, linear_solver="pardiso")
+        if ("pardiso" in linear.available_solvers())
+        else None
+    )
+    assert inexact.converged and inexact.factorisations == 1 and inexact.cg_iterations > 0
+    if exact is not None:
+        assert exact.factorisations == exact.iterations
+        assert inexact.energy == pytest.approx(exact.energy, rel=1e-12)
+        np.testing.assert_allclose(
+            inexact.material_coordinates, exact.material_coordinates, atol=1e-10 * 10.0
+        )

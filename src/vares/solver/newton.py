@@ -116,15 +116,11 @@ class NewtonContext:
     def step(
         self, matrix: sp.csr_matrix, rhs: np.ndarray, rtol: float = 0.0, definite: bool = False
     ) -> np.ndarray:
-        """Solve the Newton system to relative residual ``rtol`` (0: exactly), bordered by the
-        linear constraint when there is one (a saddle point: always factorised). ``definite``:
-        the caller has a definite matrix to try should this one be indefinite
-        (:class:`~vares.solver.linear.IndefiniteMatrixError` instead of a slow fallback)."""
-        if self.constraint is None:
-            return self.systems.solve(matrix, rhs, rtol, definite)
-        column = sp.csr_matrix(self.constraint[:, None])
-        bordered = sp.bmat([[matrix, column], [column.T, None]], format="csr")
-        return self.systems.exact(bordered, np.append(rhs, 0.0))[:-1]
+        """Solve the Newton system to relative residual ``rtol`` (0: exactly), subject to the
+        linear constraint when there is one. ``definite``: the caller has a definite matrix to
+        try should this one be indefinite (:class:`~vares.solver.linear.IndefiniteMatrixError`
+        instead of a slow fallback; a constrained system is a saddle point, never refused)."""
+        return self.systems.solve(matrix, rhs, rtol, definite, constraint=self.constraint)
 
     def record(self, record: IterationRecord) -> None:
         """Keep ``record``, with the linear work done since the record before it."""

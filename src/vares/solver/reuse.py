@@ -51,20 +51,35 @@ def forcing_term(residuals: list[float], tolerance: float) -> float:
 
 
 def preconditioned_cg(
-    matrix: sp.spmatrix, rhs: np.ndarray, preconditioner, rtol: float, budget: int
+    matrix: sp.spmatrix,
+    rhs: np.ndarray,
+    preconditioner,
+    rtol: float,
+    budget: int,
+    constraint: np.ndarray | None = None,
 ) -> tuple[np.ndarray | None, int]:
     """Conjugate gradients from zero on ``matrix x = rhs`` preconditioned by ``preconditioner``
     (a function applying an approximate inverse) until ``‖rhs − matrix x‖ ≤ rtol ‖rhs‖``.
+
+    With a unit ``constraint`` ``c`` the solution is sought where ``cᵀx = 0``: the
+    preconditioner must return such vectors (a factorisation of the matrix bordered by ``c``
+    does), and the residual is kept less its component along ``c`` (the constraint's free
+    reaction): constraint-preconditioned CG with the residual projected at every iteration, as
+    Gould, Hribar & Nocedal (2001) advise against round-off.
 
     Returns ``(x, iterations)``, or ``(None, iterations)`` when it gives up: a direction of
     non-positive curvature (the matrix or the preconditioner is not positive definite), more
     than ``budget`` iterations, or a rate of convergence that would need more than that.
     """
-    norm = float(np.linalg.norm(rhs))
+
+    def projected(r: np.ndarray) -> np.ndarray:  # less the constraint's (free) reaction
+        return r if constraint is None else r - constraint * (constraint @ r)
+
+    norm = float(np.linalg.norm(projected(rhs)))
     if norm == 0.0:
         return np.zeros_like(rhs), 0
     x = np.zeros_like(rhs)
-    r = rhs.copy()
+    r = projected(rhs)
     z = preconditioner(r)
     p = z.copy()
     rz = float(r @ z)
@@ -78,7 +93,7 @@ def preconditioned_cg(
             return None, iteration
         alpha = rz / curvature
         x += alpha * p
-        r -= alpha * q
+        r = projected(r - alpha * q)  # projected every time: no round-off along c builds up
         relative = float(np.linalg.norm(r)) / norm
         if relative <= rtol:
             return x, iteration
@@ -112,17 +127,35 @@ class ReusingSolver:
         self.cg_iterations = 0
 
     def solve(
-        self, matrix: sp.spmatrix, rhs: np.ndarray, rtol: float = 0.0, definite: bool = False
+        self,
+        matrix: sp.spmatrix,
+        rhs: np.ndarray,
+        rtol: float = 0.0,
+        definite: bool = False,
+        constraint: np.ndarray | None = None,
     ) -> np.ndarray:
         """``matrix⁻¹ rhs``, to relative residual ``rtol`` (0: as exactly as the factorisation
         solves it). ``definite``: rather :class:`~vares.solver.linear.IndefiniteMatrixError`
-        than a slow fallback when the back end factorises definite matrices only."""
-        if rtol > 0 and self.budget > 0 and self._size == matrix.shape[0]:
-            x, iterations = preconditioned_cg(matrix, rhs, self.solver.solve, rtol, self.budget)
+        than a slow fallback when the back end factorises definite matrices only. With a unit
+        ``constraint`` ``c``: the solution with ``cᵀx = 0``, from the matrix bordered by ``c``
+        (a saddle point, factorised as it is; its factorisation preconditions later ones)."""
+        size = matrix.shape[0] + (constraint is not None)
+
+        def solve(r: np.ndarray) -> np.ndarray:  # the last factorisation, as a preconditioner
+            if constraint is None:
+                return self.solver.solve(r)
+            return self.solver.solve(np.append(r, 0.0))[:-1]
+
+        if rtol > 0 and self.budget > 0 and self._size == size:
+            x, iterations = preconditioned_cg(matrix, rhs, solve, rtol, self.budget, constraint)
             self.cg_iterations += iterations
             if x is not None:
                 return x
-        return self.exact(matrix, rhs, definite)
+        if constraint is None:
+            return self.exact(matrix, rhs, definite)
+        column = sp.csr_matrix(constraint[:, None])
+        bordered = sp.bmat([[matrix, column], [column.T, None]], format="csr")
+        return self.exact(bordered, np.append(rhs, 0.0))[:-1]
 
     def exact(self, matrix: sp.spmatrix, rhs: np.ndarray, definite: bool = False) -> np.ndarray:
         """Factorise ``matrix`` (it becomes the preconditioner of later solves) and solve."""
