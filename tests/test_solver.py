@@ -128,8 +128,9 @@ def test_iteration_limit_is_reported():
 def test_singular_tangent_is_reported(monkeypatch):
     class Singular:
         name = "singular"
+        reuse_iterations = 0
 
-        def factorize(self, matrix):
+        def factorize(self, matrix, definite=False):
             raise SingularMatrixError("exactly singular")
 
     monkeypatch.setattr(api, "get_solver", lambda name: Singular())

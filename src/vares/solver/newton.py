@@ -347,7 +347,7 @@ class _Path:
 
     def __init__(self, x: np.ndarray, direction: np.ndarray, pivot: int | None) -> None:
         self.x, self.rest, self.turn = x, direction, 0.0
-        if pivot is None or x.shape[1] != 2:
+        if pivot is None:  # a pattern's (2D) steps only turn
             return
         self.centre = x[pivot]
         self.arm = x - self.centre
@@ -444,11 +444,12 @@ class _LineSearch:
         is concave in the pattern's rotation there) is stiffer against turning than the energy
         is, so its turn falls short: each iteration turns the pattern a little and lowers the
         energy a little, for dozens of iterations (a non-crimp fabric on a flat hypar whose
-        energy turns it 25°: 283 iterations)."""
-        problem, best, scale = self.problem, None, 2.0
+        energy turns it 25°: 283 iterations). The evaluation at the step's own end is not used
+        then: the next iteration evaluates the turned point."""
+        best, scale = None, 2.0
         while scale <= MAX_TURN_SCALE:
-            trial = path.at(1.0, turned=scale)
-            value = np.inf if problem.inverted_cells(trial).size else problem.energy(trial)
+            trial = path.at(1.0, turned=scale)  # turning inverts no cell the step did not
+            value = self.problem.energy(trial)
             if not value < energy - self.ctx.energy_noise:
                 break
             best, energy, scale = trial, value, 2.0 * scale

@@ -75,11 +75,11 @@ def preconditioned_cg(
     def projected(r: np.ndarray) -> np.ndarray:  # less the constraint's (free) reaction
         return r if constraint is None else r - constraint * (constraint @ r)
 
-    norm = float(np.linalg.norm(projected(rhs)))
+    r = projected(rhs)
+    norm = float(np.linalg.norm(r))
     if norm == 0.0:
         return np.zeros_like(rhs), 0
     x = np.zeros_like(rhs)
-    r = projected(rhs)
     z = preconditioner(r)
     p = z.copy()
     rz = float(r @ z)
@@ -119,8 +119,7 @@ class ReusingSolver:
 
     def __init__(self, solver: LinearSolver) -> None:
         self.solver = solver
-        self.name = solver.name
-        self.budget = int(getattr(solver, "reuse_iterations", 0))
+        self.budget = solver.reuse_iterations
         self._size: int | None = None
         #: numeric factorisations and conjugate-gradient iterations so far (failed ones too)
         self.factorisations = 0
@@ -161,9 +160,6 @@ class ReusingSolver:
         """Factorise ``matrix`` (it becomes the preconditioner of later solves) and solve."""
         self._size = None
         self.factorisations += 1
-        if definite:
-            self.solver.factorize(matrix, definite=True)
-        else:
-            self.solver.factorize(matrix)
+        self.solver.factorize(matrix, definite=definite)
         self._size = matrix.shape[0]
         return self.solver.solve(rhs)
