@@ -36,6 +36,7 @@ from ..analysis.statistics import field_statistics
 from ..io.dxf import CutPiece, write_dxf
 from ..io.files import atomic_path, write_json
 from ..io.meshes import write_surface
+from ..io.sketch import DPI, pattern_sketch
 from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
@@ -224,15 +225,26 @@ def _label(panel: PanelOutcome, job: Job) -> list[str]:
 
 
 def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> None:
-    if not (job.output.previews or job.output.plots):
+    result, mesh = panel.result, panel.mesh
+    x = result.material_coordinates
+    if job.output.previews:  # drawn without matplotlib (io/sketch.py)
+        crossings = None if result.overlap is None else result.overlap.crossings
+        sketch = pattern_sketch(
+            mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern", marks=crossings
+        )
+        for name, content in (("pattern.svg", sketch.svg()), ("pattern.png", sketch.png(DPI))):
+            path = panel.directory / name
+            with atomic_path(path) as temporary:
+                if isinstance(content, str):
+                    temporary.write_text(content, encoding="utf-8")
+                else:
+                    temporary.write_bytes(content)
+            panel.files.append(path)
+    if not job.output.plots:
         return  # matplotlib is not even imported
     import matplotlib.pyplot as plt
 
-    from ..io.plot import DPI, plot_pattern, plot_surface
-
-    result, mesh = panel.result, panel.mesh
-    x = result.material_coordinates
-    crossings = None if result.overlap is None else result.overlap.crossings
+    from ..io.plot import plot_pattern, plot_surface
 
     def save(fig, names: tuple[str, ...]) -> None:
         for name in names:
@@ -242,13 +254,6 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
             panel.files.append(path)
         plt.close(fig)
 
-    if job.output.previews:
-        save(
-            plot_pattern(
-                mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern", marks=crossings
-            ),
-            PREVIEW_FILES,
-        )
     unit = "force/length" if result.thickness == 1.0 else "stress"
     scale = material_scale * result.thickness
     for name in job.output.plots:

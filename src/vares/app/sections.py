@@ -277,8 +277,7 @@ class OutputOptions(Options):
     previews: bool = option(
         True,
         "bool",
-        "Write pattern.svg and pattern.png, pictures of the pattern (matplotlib: most of a "
-        "small job's time).",
+        "Write pattern.svg and pattern.png, pictures of the pattern with its warp and fill.",
         section="output",
         flags=("--previews/--no-previews",),
     )

@@ -21,6 +21,7 @@ from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres
 from ..mechanics.fields import FIELD_DESCRIPTIONS
 from .raster import CellImage, View, rasterise
+from .sketch import DPI, FACE, MESH, MESH_LINES_UP_TO
 
 __all__ = [
     "DPI",
@@ -37,10 +38,6 @@ __all__ = [
     "plot_surface_fields",
     "save_pattern_figure",
 ]
-
-#: Resolution of the pictures a run writes (``pattern.png``, ``surface_FIELD.png``, …): the
-#: cells of a picture are rasterised for it unless a plot is given another ``dpi``.
-DPI = 150
 
 #: Short colour bar labels of the per-cell fields; ``{stress}`` is replaced by the stress unit.
 FIELD_LABELS = {
@@ -121,10 +118,7 @@ def _colour_scale(values, field, value_range, stress_scale):
     return Normalize(low, high if high > low else low + 1e-12), "viridis"
 
 
-#: Meshes with at most this many cells show their mesh lines (on finer ones, a grey blur).
-MESH_LINES_UP_TO = 5_000
-_FACE = "#d9e6f2"
-_LINES = "#5b7a99"
+_FACE, _LINES = FACE, MESH  # as the run's preview (sketch.py)
 
 
 #: Fixed margins of a picture, inches: left, right, bottom, top (room for a title, tick labels
