@@ -13,67 +13,39 @@ The package is layered along the data path (docs/architecture.md): ``materials``
 ``geometry`` → ``mechanics`` → ``solver`` → ``analysis`` → ``structures`` → ``io`` → ``app``.
 """
 
-from . import materials
-from ._version import __version__
-from .analysis import (
-    ErectionOptions,
-    ErectionResult,
-    PatternEvaluation,
-    cell_fields,
-    compensation_report,
-    erect,
-    evaluate,
-)
-from .geometry import MeshError, ProjectionPlane, SurfaceMesh, examples, projection_plane
-from .io import read_mesh, read_mesh_data
-from .materials import Fibres
-from .mechanics import Problem
-from .options import OptionsError
-from .solver import IterationRecord, PatternResult, SolveOptions, StepRecord, solve
-from .structures import (
-    CutOptions,
-    CutResult,
-    Panel,
-    StructureOptions,
-    StructureResult,
-    cut,
-    find_seams,
-    solve_structure,
-    split_panels,
-)
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "CutOptions",
-    "CutResult",
-    "ErectionOptions",
-    "ErectionResult",
-    "Fibres",
-    "IterationRecord",
-    "MeshError",
-    "OptionsError",
-    "Panel",
-    "PatternEvaluation",
-    "PatternResult",
-    "Problem",
-    "ProjectionPlane",
-    "SolveOptions",
-    "StepRecord",
-    "StructureOptions",
-    "StructureResult",
-    "SurfaceMesh",
-    "__version__",
-    "cell_fields",
-    "compensation_report",
-    "cut",
-    "erect",
-    "evaluate",
-    "examples",
-    "find_seams",
-    "materials",
-    "projection_plane",
-    "read_mesh",
-    "read_mesh_data",
-    "solve",
-    "solve_structure",
-    "split_panels",
-]
+from ._lazy import lazy_exports
+from ._version import __version__
+
+if TYPE_CHECKING:
+    from . import materials
+    from .analysis import (
+        ErectionOptions,
+        ErectionResult,
+        PatternEvaluation,
+        cell_fields,
+        compensation_report,
+        erect,
+        evaluate,
+    )
+    from .geometry import MeshError, ProjectionPlane, SurfaceMesh, examples, projection_plane
+    from .io import read_mesh, read_mesh_data
+    from .materials import Fibres
+    from .mechanics import Problem
+    from .options import OptionsError
+    from .solver import IterationRecord, PatternResult, SolveOptions, StepRecord, solve
+    from .structures import (
+        CutOptions,
+        CutResult,
+        Panel,
+        StructureOptions,
+        StructureResult,
+        cut,
+        find_seams,
+        solve_structure,
+        split_panels,
+    )
+
+__getattr__, __dir__, _names = lazy_exports(__name__, __file__)
+__all__ = ["__version__", *_names]

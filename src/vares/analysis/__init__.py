@@ -1,28 +1,18 @@
 """What a pattern does: per-cell results of any pattern, the compensation report, statistics,
 and the erection analysis (the structure built from its patterns)."""
 
-from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
-from .checks import pattern_warnings
-from .compensation import CompensationReport, YarnReport, compensation_report
-from .erection import ErectionResult, erect
-from .erection_model import Pattern
-from .evaluate import PatternEvaluation, evaluate
-from .options import ErectionOptions
-from .statistics import field_statistics
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "FIELD_DESCRIPTIONS",
-    "KEY_FIELDS",
-    "CompensationReport",
-    "ErectionOptions",
-    "ErectionResult",
-    "Pattern",
-    "PatternEvaluation",
-    "YarnReport",
-    "cell_fields",
-    "compensation_report",
-    "erect",
-    "evaluate",
-    "field_statistics",
-    "pattern_warnings",
-]
+from .._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
+    from .checks import pattern_warnings
+    from .compensation import CompensationReport, YarnReport, compensation_report
+    from .erection import ErectionResult, erect
+    from .erection_model import Pattern
+    from .evaluate import PatternEvaluation, evaluate
+    from .options import ErectionOptions
+    from .statistics import field_statistics
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, __file__)

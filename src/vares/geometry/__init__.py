@@ -1,22 +1,15 @@
 """The fixed 3D shape: surface meshes, reference elements, flattenings (initial guesses), the
 erected warp direction, and the shipped example surfaces."""
 
-from . import examples
-from .elements import ELEMENTS, ReferenceElement
-from .flatten import ProjectionPlane, lscm, projection_distortion, projection_plane, signed_area
-from .mesh import MeshError, SurfaceMesh
-from .orientation import warp_deviation
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "ELEMENTS",
-    "MeshError",
-    "ProjectionPlane",
-    "ReferenceElement",
-    "SurfaceMesh",
-    "examples",
-    "lscm",
-    "projection_distortion",
-    "projection_plane",
-    "signed_area",
-    "warp_deviation",
-]
+from .._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from . import examples
+    from .elements import ELEMENTS, ReferenceElement
+    from .flatten import ProjectionPlane, lscm, projection_distortion, projection_plane, signed_area
+    from .mesh import MeshError, SurfaceMesh
+    from .orientation import warp_deviation
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, __file__)

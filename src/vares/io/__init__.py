@@ -4,18 +4,13 @@ Every file is written atomically (:func:`vares.io.files.atomic_path`); none is o
 the caller allows it. Drawings (matplotlib) and DXF (ezdxf) are imported where used.
 """
 
-from .files import OutputExistsError, atomic_path, check_writable, write_json
-from .meshes import read_mesh, read_mesh_data, read_pattern, write_surface
-from .summary import summary
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "OutputExistsError",
-    "atomic_path",
-    "check_writable",
-    "read_mesh",
-    "read_mesh_data",
-    "read_pattern",
-    "summary",
-    "write_json",
-    "write_surface",
-]
+from .._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from .files import OutputExistsError, atomic_path, check_writable, write_json
+    from .meshes import read_mesh, read_mesh_data, read_pattern, write_surface
+    from .summary import summary
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, __file__)

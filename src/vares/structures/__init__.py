@@ -1,27 +1,15 @@
 """Whole structures: panels, the seams between them, patterns whose seams match, and a surface
 cut into strips of roll width and nested on the roll."""
 
-from .cutting import CutResult, cut
-from .matching import MatchingRecord, StructureResult, solve_structure
-from .options import CutOptions, StructureOptions
-from .panels import Panel, split_panels, width_across_warp
-from .seams import Seam, SeamReport, find_seams, seam_lengths, seam_marks, seam_reports
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "CutOptions",
-    "CutResult",
-    "MatchingRecord",
-    "Panel",
-    "Seam",
-    "SeamReport",
-    "StructureOptions",
-    "StructureResult",
-    "cut",
-    "find_seams",
-    "seam_lengths",
-    "seam_marks",
-    "seam_reports",
-    "solve_structure",
-    "split_panels",
-    "width_across_warp",
-]
+from .._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from .cutting import CutResult, cut
+    from .matching import MatchingRecord, StructureResult, solve_structure
+    from .options import CutOptions, StructureOptions
+    from .panels import Panel, split_panels, width_across_warp
+    from .seams import Seam, SeamReport, find_seams, seam_lengths, seam_marks, seam_reports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, __file__)
