@@ -152,3 +152,26 @@ def test_solver_choice_errors(monkeypatch):
     with pytest.raises(ValueError, match="not installed"):
         get_solver("pardiso")
     assert get_solver().name == "scipy-superlu"
+
+
+def test_superlu_frees_its_factors_before_making_the_next(monkeypatch):
+    """Two factorisations alive at once were the peak of a 1M-triangle solve (4.7 GiB, 3.4
+    without): the solver must hold no factors when the next splu starts."""
+    import scipy.sparse.linalg as spla
+
+    n = 50
+    matrix = sp.diags([-np.ones(n - 1), 4 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    solver = linear.SuperLUSolver()
+    solver.factorize(matrix)
+    held_at_next = []
+    splu = spla.splu
+
+    def watching(*args, **kwargs):
+        held_at_next.append(solver._lu is not None)
+        return splu(*args, **kwargs)
+
+    monkeypatch.setattr(linear.spla, "splu", watching)
+    solver.factorize(2.0 * matrix)
+    assert held_at_next == [False]
+    rhs = np.ones(n)
+    np.testing.assert_allclose(2.0 * matrix @ solver.solve(rhs), rhs, rtol=1e-12)
