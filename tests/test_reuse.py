@@ -10,7 +10,13 @@ import scipy.sparse as sp
 import vares
 from vares import examples
 from vares.solver import linear
-from vares.solver.reuse import ETA_MAX, ReusingSolver, forcing_term, preconditioned_cg
+from vares.solver.reuse import (
+    ETA_MAX,
+    ETA_MAX_KINKED,
+    ReusingSolver,
+    forcing_term,
+    preconditioned_cg,
+)
 
 NEO_HOOKE = vares.materials.NeoHooke(1000.0, 0.3)
 
@@ -31,6 +37,9 @@ def test_forcing_term_follows_eisenstat_walker_and_the_tolerance():
     # a residual that grew, or fell little: the loosest
     assert forcing_term([1.0, 2.0], 1e-10) == ETA_MAX
     assert forcing_term([1.0, 0.5], 1e-10) == ETA_MAX
+    # an energy with kinks: a tighter cap, the same formula below it
+    assert forcing_term([1.0, 0.5], 1e-10, ETA_MAX_KINKED) == ETA_MAX_KINKED
+    assert forcing_term([1.0, 0.01], 1e-12, ETA_MAX_KINKED) == pytest.approx(0.9e-4)
 
 
 def test_cg_with_the_exact_inverse_takes_one_iteration():

@@ -30,6 +30,7 @@ from ..solver.linear import get_solver
 from ..solver.newton import NewtonContext, describe_cells
 from ..solver.options import SolveOptions
 from ..solver.result import IterationRecord, PatternResult, StepRecord
+from ..solver.reuse import ETA_MAX, ETA_MAX_KINKED
 from ..solver.strategies import Attempt, follow_plan
 from .erection_fields import erection_statistics, membrane_forces, node_normals
 from .erection_model import Pattern, Structure, build_structure, patterns_of
@@ -300,6 +301,7 @@ def _context(
         steps=[],
         callback=callback,
         round_off_regime=ROUND_OFF_REGIME,
+        loosest_forcing=ETA_MAX_KINKED if problem.wrinkling else ETA_MAX,
     )
 
 

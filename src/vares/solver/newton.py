@@ -25,7 +25,7 @@ from ..materials import InadmissibleState
 from ..mechanics.assembly import Assembler
 from .linear import LinearSolver, SingularMatrixError
 from .result import IterationRecord, StepRecord
-from .reuse import ReusingSolver, forcing_term
+from .reuse import ETA_MAX, ReusingSolver, forcing_term
 
 __all__ = [
     "EXACT_TANGENT_BELOW",
@@ -97,6 +97,9 @@ class NewtonContext:
     #: an objective whose energy has kinks (the erection's tension field) stalls above its
     #: round-off floor where states switch, and sets it lower.
     round_off_regime: float = ROUND_OFF_REGIME
+    #: The loosest relative accuracy of a Newton step (:func:`~vares.solver.reuse.forcing_term`);
+    #: an objective with kinks sets it tighter.
+    loosest_forcing: float = ETA_MAX
     #: The node a pattern free to turn (``orientation="free"``) turns about in a line search's
     #: steps (:class:`_Path`); ``None``: steps are straight lines.
     turning_about: int | None = None
@@ -252,7 +255,7 @@ def newton(
         if iteration == ctx.max_iterations:
             raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
         norms.append(residual)
-        eta = forcing_term(norms, ctx.residual_tolerance)
+        eta = forcing_term(norms, ctx.residual_tolerance, ctx.loosest_forcing)
         if method == "full":
             x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector, eta)
             evaluation = None

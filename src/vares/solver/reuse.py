@@ -25,29 +25,35 @@ import scipy.sparse as sp
 
 from .linear import LinearSolver
 
-__all__ = ["ETA_MAX", "ReusingSolver", "forcing_term", "preconditioned_cg"]
+__all__ = ["ETA_MAX", "ETA_MAX_KINKED", "ReusingSolver", "forcing_term", "preconditioned_cg"]
 
-#: The loosest relative accuracy a Newton step is solved to.
+#: The loosest relative accuracy a Newton step is solved to (a smooth energy's).
 ETA_MAX = 0.1
+#: … of an energy with kinks (the erection's tension field): where cells switch between taut,
+#: wrinkled and slack the residual barely falls for many iterations and the forcing term sits
+#: at its cap; steps solved to 0.1 then took 1.3–2× the iterations (and 1.4–1.6× the time) of
+#: steps solved to 1e-3 with SuperLU (docs/erection.md), which cost a few CG iterations more.
+ETA_MAX_KINKED = 1e-3
 
 
-def forcing_term(residuals: list[float], tolerance: float) -> float:
+def forcing_term(residuals: list[float], tolerance: float, loosest: float = ETA_MAX) -> float:
     """How accurately (relative linear residual) to solve the next Newton step, from the
     residual norms of this Newton iteration so far (the last is the current one).
 
     Eisenstat and Walker's second choice, ``η = 0.9 (‖r_k‖ / ‖r_{k−1}‖)²``, at most
-    :data:`ETA_MAX` (which makes their safeguard against a sudden drop, active above
-    ``η_{k−1} = 1/3``, moot), and never tighter than half the ``tolerance`` (an absolute
-    residual) asks of the next iterate; ``ETA_MAX`` at the first iteration.
+    ``loosest`` (:data:`ETA_MAX`, which makes their safeguard against a sudden drop, active
+    above ``η_{k−1} = 1/3``, moot; :data:`ETA_MAX_KINKED` for an energy with kinks), and never
+    tighter than half the ``tolerance`` (an absolute residual) asks of the next iterate;
+    ``loosest`` at the first iteration.
     """
     current = residuals[-1]
     if len(residuals) < 2 or residuals[-2] <= 0:
-        eta = ETA_MAX
+        eta = loosest
     else:
         eta = 0.9 * (current / residuals[-2]) ** 2
     if current > 0:
         eta = max(eta, 0.5 * tolerance / current)
-    return min(eta, ETA_MAX)
+    return min(eta, loosest)
 
 
 def preconditioned_cg(
