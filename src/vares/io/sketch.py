@@ -16,6 +16,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from html import escape
+from pathlib import Path
 
 import numpy as np
 
@@ -235,7 +236,7 @@ class Sketch:
     # -- PNG -----------------------------------------------------------------------------
     def png(self, dpi: float = DPI, compress_level: int = 4) -> bytes:
         """The sketch painted at ``dpi`` as PNG bytes (Pillow)."""
-        from PIL import Image, ImageDraw, ImageFont
+        from PIL import Image, ImageDraw
 
         k = dpi / POINT * SUPERSAMPLE  # samples per point
         width, height = self.size
@@ -250,8 +251,8 @@ class Sketch:
         def stroke(points_width: float) -> int:
             return max(1, round(points_width * k))
 
-        font = ImageFont.load_default(size=max(1, round(FONT_SIZE * k)))
-        title_font = ImageFont.load_default(size=max(1, round(TITLE_SIZE * k)))
+        font, minus = _font(FONT_SIZE * k)
+        title_font, _ = _font(TITLE_SIZE * k)
         arrows = []
         for item in self._items:
             kind = item[0]
@@ -289,12 +290,12 @@ class Sketch:
             if axis == "x":
                 y = (top + h) * k
                 draw.line([(position * k, y), (position * k, y + 3.5 * k)], fill=INK, width=lw)
-                label = label.replace("\u2212", "-")  # Pillow's font has no U+2212
+                label = label.replace("\u2212", minus)
                 draw.text((position * k, y + 5 * k), label, fill=INK, font=font, anchor="mt")
             else:
                 x = left * k
                 draw.line([(x - 3.5 * k, position * k), (x, position * k)], fill=INK, width=lw)
-                label = label.replace("\u2212", "-")
+                label = label.replace("\u2212", minus)
                 draw.text((x - 5 * k, position * k), label, fill=INK, font=font, anchor="rm")
         for _, a, b, label, dashed, width_ in arrows:
             base, head, at = self._arrow_parts(a, b, width_, label)
@@ -311,6 +312,24 @@ class Sketch:
         buffer = io.BytesIO()
         image.save(buffer, format="PNG", compress_level=compress_level, dpi=(dpi, dpi))
         return buffer.getvalue()
+
+
+def _font(size: float):
+    """The font of matplotlib's pictures (DejaVu Sans, shipped in its data; found without
+    importing it) at ``size`` pixels, and the minus sign it has; else Pillow's own font, which
+    has no U+2212."""
+    from importlib.util import find_spec
+
+    from PIL import ImageFont
+
+    size = max(1, round(size))
+    spec = find_spec("matplotlib")
+    folders = (spec.submodule_search_locations or []) if spec is not None else []
+    for folder in folders:
+        path = Path(folder, "mpl-data", "fonts", "ttf", "DejaVuSans.ttf")
+        if path.is_file():
+            return ImageFont.truetype(str(path), size), "\u2212"
+    return ImageFont.load_default(size=size), "-"
 
 
 def _svg_loop(points: np.ndarray) -> str:
