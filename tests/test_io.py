@@ -152,6 +152,54 @@ def test_rhino_3dm_round_trip_and_names(tmp_path):
     assert result.exit_code == 0, result.stderr
 
 
+def _unwelded_3dm(path, objects):
+    """A Rhino file of meshes stored as Rhino often keeps them: a vertex per face at a seam
+    (here the column x = 0 of each hypar, duplicated for the cells right of it)."""
+    import rhino3dm
+
+    model = rhino3dm.File3dm()
+    for name, mesh in objects:
+        points, cells = [tuple(p) for p in mesh.points], mesh.cells["triangle"].copy()
+        right = mesh.points[cells].mean(axis=1)[:, 0] > 0
+        copies = {}
+        for row in np.flatnonzero(right):
+            for k, node in enumerate(cells[row]):
+                if abs(mesh.points[node, 0]) < 1e-12:
+                    if node not in copies:
+                        copies[node] = len(points)
+                        points.append(tuple(mesh.points[node]))
+                    cells[row, k] = copies[node]
+        rhino_mesh = rhino3dm.Mesh()
+        for point in points:
+            rhino_mesh.Vertices.Add(*map(float, point))
+        for a, b, c in cells:
+            rhino_mesh.Faces.AddFace(int(a), int(b), int(c))
+        attributes = rhino3dm.ObjectAttributes()
+        attributes.Name = name
+        model.Objects.AddMesh(rhino_mesh, attributes)
+    model.Write(str(path), 7)
+    return path
+
+
+def test_rhino_meshes_with_a_vertex_per_face_at_seams_are_welded(tmp_path):
+    roof = vares.examples.hypar(n=8)
+    path = _unwelded_3dm(tmp_path / "roof.3dm", [("roof", roof)])
+    with pytest.warns(UserWarning, match=r"welded 9 node\(s\)"):
+        mesh = vares.read_mesh(path)
+    assert mesh.num_points == roof.num_points and len(mesh.boundary_loops()) == 1
+    result = run("pattern", path, "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["repairs"]["roof.3dm"]["welded_nodes"] == 9
+    # a file of panels: each object welded, the repair said
+    two = _unwelded_3dm(tmp_path / "two.3dm", [("a", roof), ("b", roof)])
+    meshes = read_3dm(two)
+    assert [m.repair.welded_nodes for m in meshes] == [9, 9]
+    assert all(m.mesh.num_points == roof.num_points for m in meshes)
+    with pytest.raises(vares.MeshError, match="2 separate pieces"):
+        read_3dm(two, repair_meshes=False)
+
+
 def test_rhino_files_without_meshes(tmp_path):
     import rhino3dm
 

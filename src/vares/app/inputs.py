@@ -121,8 +121,15 @@ def _example(job: Job) -> Input:
 def _structure(job: Job) -> Input:
     paths = [job.path(p) for p in job.input.paths]
     if len(paths) == 1 and paths[0].suffix.lower() == ".3dm":
-        panels = [Panel(m.name, m.mesh) for m in read_3dm(paths[0])]
+        meshes = read_3dm(paths[0], repair_meshes=job.input.repair)
+        panels = [Panel(m.name, m.mesh) for m in meshes]
         loaded = Input(panels, _units(job, [unit_system(paths[0])]))
+        for m in meshes:
+            if m.repair.changed:
+                loaded.repairs[f"{paths[0].name}: {m.name}"] = m.repair.to_dict()
+                loaded.warnings.append(
+                    f"repaired {paths[0].name}, object {m.name!r}: {'; '.join(m.repair.actions())}"
+                )
     elif len(paths) > 1:
         files = [_read(job, p) for p in paths]
         panels = [Panel(f.path.stem, f.surface()) for f in files]

@@ -208,15 +208,15 @@ def read_raw(path: Path) -> RawSurface:
 
 
 def _read_3dm(path: Path) -> RawSurface:
-    from .rhino import read_3dm, unit_system
+    from .rhino import read_3dm_raw, unit_system
 
-    meshes = read_3dm(path)
+    meshes = read_3dm_raw(path)
     if len(meshes) > 1:
         names = ", ".join(m.name for m in meshes)
         raise MeshError(
             f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels ('vares panels')"
         )
-    mesh = meshes[0].mesh
+    mesh = meshes[0]
     units = unit_system(path)
     resolution = float(np.spacing(np.float32(np.abs(mesh.points).max())))
     return RawSurface(np.array(mesh.points), mesh.cells, units=units, resolution=resolution)

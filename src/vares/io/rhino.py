@@ -8,15 +8,16 @@ and named in the error if no mesh is left.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..geometry.mesh import MeshError, SurfaceMesh
+from ..geometry.repair import RepairReport, repair
 from ..geometry.weld import coincident_nodes
 
-__all__ = ["NamedMesh", "read_3dm", "unit_system", "write_3dm"]
+__all__ = ["NamedMesh", "RawMesh", "read_3dm", "read_3dm_raw", "unit_system", "write_3dm"]
 
 #: Rhino unit systems and vares' names for them.
 _UNITS = {
@@ -30,11 +31,24 @@ _UNITS = {
 
 @dataclass(frozen=True)
 class NamedMesh:
-    """A mesh read from a file, with the name and layer it had there."""
+    """A mesh read from a file, with the name and layer it had there, and what its repair
+    changed (:func:`vares.geometry.repair.repair`)."""
 
     name: str
     layer: str
     mesh: SurfaceMesh
+    repair: RepairReport = field(default_factory=RepairReport)
+
+
+@dataclass(frozen=True)
+class RawMesh:
+    """An object's mesh as the file stores it (a Brep's face meshes joined): points and cells,
+    not yet repaired nor checked."""
+
+    name: str
+    layer: str
+    points: np.ndarray
+    cells: dict[str, np.ndarray]
 
 
 def _rhino_mesh_arrays(mesh) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -70,15 +84,15 @@ def _weld(parts: list[tuple[np.ndarray, dict[str, np.ndarray]]]):
     return points[first], {t: np.vstack(b) for t, b in cells.items()}
 
 
-def read_3dm(path: str | Path) -> list[NamedMesh]:
-    """All meshes of a Rhino file, named (see the module docs).
+def read_3dm_raw(path: str | Path) -> list[RawMesh]:
+    """Every object's mesh of a Rhino file as stored, named (see the module docs).
 
     Raises
     ------
     FileNotFoundError
         No such file.
     MeshError
-        Not a readable 3dm file, no usable mesh in it, or an invalid mesh (naming the object).
+        Not a readable 3dm file, or no usable mesh in it.
     """
     import rhino3dm
 
@@ -113,14 +127,33 @@ def read_3dm(path: str | Path) -> list[NamedMesh]:
             skipped.append(name)
             continue
         points, cells = parts[0] if len(parts) == 1 else _weld(parts)
-        try:
-            mesh = SurfaceMesh(points, cells, drop_unused_nodes=True)
-        except MeshError as exc:
-            raise MeshError(f"{path}: object {name!r}: {exc}") from exc
-        out.append(NamedMesh(name, layer, mesh))
+        out.append(RawMesh(name, layer, points, cells))
     if not out:
         detail = f" (no render mesh in {', '.join(skipped)}: save with meshes)" if skipped else ""
         raise MeshError(f"{path} contains no usable mesh{detail}")
+    return out
+
+
+def read_3dm(path: str | Path, *, repair_meshes: bool = True) -> list[NamedMesh]:
+    """All meshes of a Rhino file, named (see the module docs), each repaired as a mesh file
+    is (:func:`vares.geometry.repair.repair`: Rhino meshes often keep a vertex per face at
+    creases and seams, which would cut the surface apart), unless ``repair_meshes`` is false.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    MeshError
+        Not a readable 3dm file, no usable mesh in it, or an invalid mesh (naming the object).
+    """
+    out = []
+    for raw in read_3dm_raw(path):
+        try:
+            fixed = repair(raw.points, raw.cells, weld=repair_meshes)
+            mesh = SurfaceMesh(fixed.points, fixed.cells)
+        except MeshError as exc:
+            raise MeshError(f"{path}: object {raw.name!r}: {exc}") from exc
+        out.append(NamedMesh(raw.name, raw.layer, mesh, fixed.report))
     return out
 
 
