@@ -7,10 +7,11 @@ Every run is a fresh `vares pattern FILE -o DIR --force` process (compiled kerne
 disk, as after the first run of an install), in three variants: `--no-previews`, the default
 (SVG and PNG previews) and `--report`. Prints the median wall time of the whole process, the
 solve's own time (``elapsed_seconds`` + ``warm_up_seconds`` of summary.json) and what the
-report adds. The command is the ``vares`` script installed beside this Python (a version
-manager's shim on PATH, such as pyenv's, adds its own start-up: 0.08 s here), else the one on
-PATH; it imports the package from PYTHONPATH first: ``PYTHONPATH=src`` measures this tree's
-code.
+report adds; and, first, what merely loading the libraries a run uses costs: a script that
+imports them and calls one compiled (cached) numba function, the floor under any command.
+The command is the ``vares`` script installed beside this Python (a version manager's shim on
+PATH, such as pyenv's, adds its own start-up: 0.08 s here), else the one on PATH; it imports
+the package from PYTHONPATH first: ``PYTHONPATH=src`` measures this tree's code.
 """
 
 from __future__ import annotations
@@ -50,6 +51,31 @@ def run(path: Path, out: Path, flags: list[str]) -> tuple[float, float]:
     return wall, summary["elapsed_seconds"] + summary.get("warm_up_seconds", 0.0)
 
 
+#: What a `vares pattern` run loads, without vares: the floor of its time.
+LIBRARIES = """\
+import numpy as np, scipy.sparse, scipy.sparse.csgraph, scipy.spatial, numba
+import ezdxf, typer, rich, meshio, shapely, PIL.Image
+
+@numba.njit(cache=True)
+def first(x):
+    return x.sum()
+
+first(np.ones(3))
+"""
+
+
+def libraries_alone(folder: Path, repeat: int) -> float:
+    script = folder / "libraries.py"
+    script.write_text(LIBRARIES)
+    subprocess.run([sys.executable, str(script)], check=True)  # compiles once, cached after
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        subprocess.run([sys.executable, str(script)], check=True)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
@@ -61,6 +87,8 @@ def main() -> None:
     print("|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
+        floor = libraries_alone(folder, args.repeat)
+        print(f"| (no surface) | the libraries alone | {floor:.2f} | | |")
         for size in args.sizes:
             label, make = SIZES[size]
             mesh = make()
