@@ -4,6 +4,7 @@ and a plain `import vares` or a pattern's work loads no more than it needs."""
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import subprocess
 import sys
 
@@ -23,6 +24,24 @@ PACKAGES = [
 ]
 
 
+def _exports_a_module(package: str, name: str) -> bool:
+    """Whether ``package.name`` is a module by its lazy imports (``from . import examples``,
+    or a name re-exported from a package that imports it so)."""
+    path = importlib.util.find_spec(package).origin
+    with open(path, encoding="utf-8") as source:
+        exports = _exports(source.read())
+    if name not in exports:
+        return False
+    module, attribute = exports[name]
+    if not attribute:
+        return True
+    source_package = importlib.util.resolve_name(module, package)
+    spec = importlib.util.find_spec(source_package)
+    return spec.submodule_search_locations is not None and _exports_a_module(
+        source_package, attribute
+    )
+
+
 @pytest.mark.parametrize("name", PACKAGES)
 def test_every_exported_name_resolves(name: str) -> None:
     package = importlib.import_module(name)
@@ -30,17 +49,27 @@ def test_every_exported_name_resolves(name: str) -> None:
     for attribute in package.__all__:
         value = getattr(package, attribute)
         assert value is not None
-        if not attribute.startswith("__") and not isinstance(value, type(package)):
+        if _exports_a_module(name, attribute):  # from . import examples
+            assert isinstance(value, type(sys)), f"{name}.{attribute}"
+        elif not attribute.startswith("__"):
             assert not isinstance(value, type(sys)), f"{name}.{attribute} is a module"
     assert set(package.__all__) <= set(dir(package))
 
 
 def test_a_name_shared_with_its_module_is_the_function() -> None:
+    """Importing the module ``vares.analysis.evaluate`` leaves ``vares.analysis.evaluate`` the
+    function, as the eager ``from .evaluate import evaluate`` did; in a fresh process, the
+    package's import does not import that module."""
+    loaded = _loaded_after("import vares.analysis")
+    assert "vares.analysis.evaluate" not in loaded
     import vares.analysis.evaluate  # the module imported first: the package keeps the function
     import vares.io.summary
+    from vares.analysis.evaluate import PatternEvaluation
 
     assert callable(vares.evaluate) and vares.evaluate.__name__ == "evaluate"
+    assert vares.analysis.evaluate is vares.evaluate
     assert callable(vares.io.summary) and vares.io.summary.__name__ == "summary"
+    assert PatternEvaluation.__module__ == "vares.analysis.evaluate"
 
 
 def test_subpackages_and_unknown_names() -> None:

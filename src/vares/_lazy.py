@@ -16,6 +16,7 @@ import ast
 import importlib
 import importlib.util
 import sys
+import types
 from collections.abc import Callable
 from pathlib import Path
 
@@ -43,19 +44,31 @@ def _exports(source: str) -> dict[str, tuple[str, str]]:
     return exports
 
 
+class _Package(types.ModuleType):
+    """A package some of whose names are those of their own modules (``evaluate`` from
+    ``.evaluate``): importing such a module, which sets it as the package's attribute of that
+    name, leaves the name to the function, as an eager ``from .evaluate import evaluate`` in
+    the ``__init__`` did."""
+
+    def __setattr__(self, name: str, value: object) -> None:
+        if isinstance(value, types.ModuleType) and name in self.__dict__.get("_shadowing", ()):
+            return
+        super().__setattr__(name, value)
+
+
 def lazy_exports(
     package: str, file: str
 ) -> tuple[Callable[[str], object], Callable[[], list[str]], list[str]]:
     """``__getattr__``, ``__dir__`` and ``__all__`` of the package ``package`` whose
     ``__init__`` is ``file``, from its ``if TYPE_CHECKING:`` imports."""
     exports = _exports(Path(file).read_text(encoding="utf-8"))
-    for name, (module_name, attribute) in exports.items():
-        if attribute and module_name.rsplit(".", 1)[-1] == name:
-            # a name shared with its own module (``evaluate`` from ``.evaluate``): importing the
-            # module anywhere would make the package attribute the module, so the name is
-            # imported now, as an eager ``from .evaluate import evaluate`` would
-            module = importlib.import_module(module_name, package)
-            setattr(sys.modules[package], name, getattr(module, attribute))
+    module = sys.modules[package]
+    module.__dict__["_shadowing"] = frozenset(
+        name
+        for name, (module_name, attribute) in exports.items()
+        if attribute and module_name.rsplit(".", 1)[-1] == name
+    )
+    module.__class__ = _Package
 
     def __getattr__(name: str) -> object:
         try:

@@ -5,24 +5,21 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.table import Table
 
-from ...analysis.erection import ErectionResult
-from ...analysis.statistics import field_statistics
-from ...geometry.mesh import MeshError
-from ...io.files import OutputExistsError
-from ...materials import MaterialError
-from ...mechanics.fields import KEY_FIELDS
-from ...options import OptionsError
-from ...solver.result import IterationRecord
-from ..job import Job, JobError
-from ..outcome import JobOutcome, PanelOutcome
-from ..runner import run_job
 from .flags import InputError
+
+if TYPE_CHECKING:  # the engine is imported when a command runs, not to build the command line
+    import numpy as np
+
+    from ...analysis.erection import ErectionResult
+    from ...solver.result import IterationRecord
+    from ..job import Job
+    from ..outcome import JobOutcome, PanelOutcome
 
 __all__ = ["console", "execute", "fail", "field_table", "guarded", "show_erection"]
 
@@ -38,6 +35,12 @@ def fail(message: str, code: int) -> int:
 def guarded(body: Callable[[], None]) -> None:
     """Run a command body, turning known errors into one-line messages and exit codes (2: bad
     input or options, 1: the solve did not converge, 3: unexpected internal error)."""
+    from ...geometry.mesh import MeshError
+    from ...io.files import OutputExistsError
+    from ...materials import MaterialError
+    from ...options import OptionsError
+    from ..job import JobError
+
     try:
         body()
     except typer.Exit:
@@ -80,6 +83,9 @@ def progress(quiet: bool) -> Callable[[IterationRecord], None] | None:
 
 
 def field_table(fields: dict[str, np.ndarray]) -> Table:
+    from ...analysis.statistics import field_statistics
+    from ...mechanics.fields import KEY_FIELDS
+
     table = Table(
         "field",
         "min",
@@ -249,6 +255,8 @@ def show(outcome: JobOutcome) -> None:
 
 def execute(job: Job, *, force: bool, quiet: bool, save_job: Path | None = None) -> None:
     """Run a job from the command line: progress, summary, ``--save-job``, exit status."""
+    from ..runner import run_job
+
     if save_job is not None and save_job.suffix.lower() != ".toml":
         raise InputError(f"--save-job: a job file ends in .toml; got {save_job}")
 
