@@ -128,3 +128,25 @@ def test_pattern_command_does_not_import_matplotlib(tmp_path) -> None:
     png = Image.open(tmp_path / "out" / "pattern.png")
     assert png.size[0] > 500
     ET.parse(tmp_path / "out" / "pattern.svg")
+
+
+def test_a_long_strip_keeps_its_arrows_inside_and_its_ticks_apart() -> None:
+    """A strip 20 × 2 (as a cut job's): the fibre arrows end inside the strip's box, and the
+    short axis carries no more tick labels than fit: 10-point labels 15 points apart or more."""
+    n_u, n_v = 41, 5
+    u, v = np.meshgrid(np.linspace(-10.0, 10.0, n_u), np.linspace(-1.0, 1.0, n_v))
+    points = np.column_stack([u.ravel(), v.ravel(), np.zeros(u.size)])
+    mesh = SurfaceMesh(points, grid_cells(n_u, n_v, "triangle"))
+    sketch = pattern_sketch(mesh, points[:, :2], fibres=Fibres.from_angles(0.0))
+    root = ET.fromstring(sketch.svg())
+    low, high = sketch.place(np.array([[-10.0, 1.0], [10.0, -1.0]]))
+    for line in root.iter(f"{SVG}line"):
+        if line.get("stroke-width") == "1.4":  # the arrows' shafts
+            for end in ("1", "2"):
+                x, y = float(line.get(f"x{end}")), float(line.get(f"y{end}"))
+                assert low[0] <= x <= high[0] and low[1] <= y <= high[1]
+    ticks = [t for t in sketch._ticks() if t[0] == "y"]
+    _, _, _, height = sketch.axes
+    assert 2 <= len(ticks) <= max(3, height / 25)
+    positions = sorted(t[1] for t in ticks)
+    assert min(np.diff(positions)) >= 15.0

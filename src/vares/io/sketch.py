@@ -133,9 +133,12 @@ class Sketch:
     def _ticks(self) -> list[tuple[str, float, str]]:
         """``(axis, position in points, label)`` of every tick."""
         x0, x1, y0, y1 = self.limits
+        _, _, width, height = self.axes
         ticks = []
+        # labels side by side need some 45 points each along x, 25 along y
+        room = {"x": max(3, int(width / 45)), "y": max(3, int(height / 25))}
         for axis, low, high in (("x", x0, x1), ("y", y0, y1)):
-            values = nice_ticks(low, high)
+            values = nice_ticks(low, high, min(8, room[axis]))
             step = float(values[1] - values[0]) if len(values) > 1 else abs(high - low) or 1.0
             for value in values:
                 point = (value, y0) if axis == "x" else (x0, value)
@@ -414,7 +417,8 @@ def pattern_sketch(
         sketch.rings(np.asarray(marks, dtype=float), MARK)
     if fibres is not None:
         centre = coordinates.mean(axis=0)
-        length = 0.15 * float(np.ptp(coordinates, axis=0).max())
+        extent = np.ptp(coordinates, axis=0)  # arrows inside the pattern's box, as long a strip's
+        length = min(0.15 * float(extent.max()), 0.35 * float(extent.min()))
         sketch.arrow(centre, centre + length * np.asarray(fibres.warp), "warp")
         sketch.arrow(centre, centre + length * np.asarray(fibres.fill), "fill", dashed=True)
     return sketch
