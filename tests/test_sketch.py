@@ -150,3 +150,30 @@ def test_a_long_strip_keeps_its_arrows_inside_and_its_ticks_apart() -> None:
     assert 2 <= len(ticks) <= max(3, height / 25)
     positions = sorted(t[1] for t in ticks)
     assert min(np.diff(positions)) >= 15.0
+
+
+def test_an_outline_that_cannot_be_followed_fills_every_cell(monkeypatch) -> None:
+    """Where the boundary's loops cannot be followed (it passes twice through a node), the
+    sketch fills the cells one by one and draws the boundary edges: the same picture."""
+    from vares.geometry.mesh import MeshError
+
+    mesh, x = _square_with_hole()
+    reference = Image.open(io.BytesIO(pattern_sketch(mesh, x).png(72.0))).convert("RGB")
+
+    def refuse(self):
+        raise MeshError("the boundary passes twice through node 7")
+
+    monkeypatch.setattr(SurfaceMesh, "boundary_loops", refuse)
+    sketch = pattern_sketch(mesh, x)
+    root = ET.fromstring(sketch.svg())
+    filled = [p for p in root.iter(f"{SVG}path") if p.get("fill") == FACE]
+    assert len(filled) == mesh.num_cells
+    image = Image.open(io.BytesIO(sketch.png(72.0))).convert("RGB")
+    difference = np.abs(np.asarray(image, int) - np.asarray(reference, int)).max(axis=-1)
+    assert np.mean(difference > 40) < 0.01  # the same picture but for antialiasing
+    assert colour_at(sketch, image, (2.0, 2.0), 72.0) == (255, 255, 255)  # the hole stays empty
+
+
+def colour_at(sketch, image, point, dpi: float) -> tuple[int, int, int]:
+    column, row = sketch.place(np.asarray(point, dtype=float)) * dpi / 72
+    return image.getpixel((int(column), int(row)))
