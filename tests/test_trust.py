@@ -292,3 +292,120 @@ def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
     assert not (tmp_path / "out" / OWNER).exists()
     manifest = json.loads((tmp_path / "out" / ".vares-run.json").read_text())
     assert OWNER not in manifest["files"]
+
+
+def _ended_pid() -> int:
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)  # fmt: skip
+    return int(done.stdout)
+
+
+def test_a_run_killed_in_the_middle_of_the_swap_gets_the_previous_run_back(tmp_path):
+    """Killed between moving the previous run aside and putting the new one in place, a run
+    leaves no output folder: the next run into it puts the previous run back first."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    killed = (
+        "import os, sys\n"
+        "from vares.app import staging\n"
+        "replace = os.replace\n"
+        "def dying(a, b):\n"
+        f"    if str(b) == {str(out)!r}:  # the new run into place: the old one is aside\n"
+        "        os._exit(9)  # killed: no clean-up runs\n"
+        "    replace(a, b)\n"
+        "staging.os.replace = dying\n"
+        "from vares.app.cli.main import app\n"
+        f"app(['example', 'hypar', '-o', {str(out)!r}, '-q', '--force', '--E', '2000'])\n"
+    )
+    done = subprocess.run([sys.executable, "-c", killed], capture_output=True, text=True)
+    assert done.returncode == 9, done.stderr
+    assert not out.exists() and any(p.name.startswith(".out.old-") for p in tmp_path.iterdir())
+    result = run("example", "hypar", "-o", out, "-q")  # no --force: the old run is back
+    assert result.exit_code == 2 and "output exists" in error_line(result)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    # the killed run's staging folder (it named its process) is gone as well
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_an_interrupt_in_the_middle_of_the_swap_puts_the_previous_run_back(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    from vares.app import staging
+
+    replace = staging.os.replace
+
+    def interrupted(a, b):
+        if str(b) == str(out) and not str(a).endswith("run"):  # the old run is aside
+            raise KeyboardInterrupt
+        replace(a, b)
+
+    monkeypatch.setattr(staging.os, "replace", interrupted)
+    result = run("example", "hypar", "-o", out, "-q", "--force", "--E", "2000")
+    monkeypatch.undo()
+    assert result.exit_code == 130
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_a_killed_erections_staging_folder_does_not_block_the_runs_rerun(tmp_path):
+    from vares.app.staging import OWNER
+
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    leftover = out / ".erect.vares-killed"
+    leftover.mkdir()
+    (leftover / "erect.json").write_text("half written")
+    owner = {"pid": _ended_pid(), "host": __import__("socket").gethostname()}
+    (leftover / OWNER).write_text(json.dumps(owner))
+    result = run("example", "hypar", "-o", out, "-q", "--force")
+    assert result.exit_code == 0, result.stderr
+    assert not leftover.exists()
+
+
+def test_an_erection_killed_before_its_commit_leaves_its_old_files_known(tmp_path, monkeypatch):
+    """The run's manifest lists the old and the new erect/ files until the new ones are in
+    place: a rerun after a kill there does not take the old report for a stranger's file."""
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    assert run("erect", out, "-q", "--report").exit_code == 0
+    from vares.app import staging
+
+    def killed(self):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(staging.OutputFolder, "commit", killed)
+    assert run("erect", out, "-q", "-f").exit_code == 130  # without the report
+    monkeypatch.undo()
+    listed = json.loads((out / ".vares-run.json").read_text())["files"]
+    assert "erect/report.html" in listed and "erect/erect.json" in listed
+    assert (out / "erect" / "report.html").is_file()  # the previous erection, whole
+    result = run("erect", out, "-q", "-f")
+    assert result.exit_code == 0, result.stderr
+    listed = json.loads((out / ".vares-run.json").read_text())["files"]
+    assert "erect/report.html" not in listed and not (out / "erect" / "report.html").exists()
+
+
+def test_a_run_of_another_command_or_the_current_folder_is_never_replaced(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    assert run("example", "hypar", "-o", out, "-q").exit_code == 0
+    before = sorted(p.name for p in out.iterdir())
+    result = run("evaluate", out / "surface.obj", out / "pattern.obj", "-o", out, "--force")
+    assert result.exit_code == 2  # its inputs lie there too; copied out, the run is refused
+    surface, pattern = tmp_path / "s.obj", tmp_path / "p.obj"
+    surface.write_bytes((out / "surface.obj").read_bytes())
+    pattern.write_bytes((out / "pattern.obj").read_bytes())
+    result = run("evaluate", surface, pattern, "-o", out, "--force", "-q")
+    assert result.exit_code == 2 and "holds a job run" in error_line(result)
+    assert sorted(p.name for p in out.iterdir()) == before
+    monkeypatch.chdir(out)
+    result = run("example", "hypar", "-o", ".", "-q", "--force")
+    assert result.exit_code == 2 and "the current folder" in error_line(result)
+    assert sorted(p.name for p in out.iterdir()) == before

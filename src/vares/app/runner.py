@@ -22,7 +22,7 @@ from ..analysis.erection_model import Pattern
 from ..analysis.options import ErectionOptions
 from ..geometry.examples import EXAMPLE_PLANES
 from ..geometry.mesh import SurfaceMesh
-from ..io.files import check_writable, write_with
+from ..io.files import check_writable, write_text
 from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
 from ..structures.matching import solve_structure
@@ -159,7 +159,7 @@ def _write(outcome: JobOutcome, root: Path, save_job: Path | None, folder: Outpu
 
 def _save_job(job: Job, path: Path, location: Path | None = None) -> None:
     text = job.to_toml(location or path)
-    write_with(path, lambda p: p.write_text(text, encoding="utf-8"))
+    write_text(path, text)
 
 
 def _moved(outcome: JobOutcome, directory: Path, root: Path) -> None:
@@ -256,9 +256,11 @@ def run_erection(
 
             staged.append(write_erection_report(result, root, units))
         files = [folder.directory / Path(p).relative_to(root) for p in staged]
-        # listed first: killed before the commit, the run's folder still knows erect/ is its own
-        add_to_manifest(directory, files, replacing=folder.directory)
+        # listed beside the old ones first: killed before the commit, the run's folder still
+        # knows every file of erect/ as its own; trimmed to the new ones once they are in place
+        add_to_manifest(directory, files, replacing=None)
         folder.commit()
+        add_to_manifest(directory, files, replacing=folder.directory)
     finally:
         folder.discard()
     return ErectionRun(job, result, files, units)

@@ -4,14 +4,18 @@ A run writes its files into a hidden staging folder next to the output folder. W
 is written, the staging folder takes the output folder's place (the previous run, if any, is
 moved aside first and then deleted), so an output folder holds one whole run or the previous
 one — never a mix, also when a run is interrupted. A manifest (``.vares-run.json``) lists the
-files of the run, so the next run knows which files it may replace. A staging folder left by a
-process that was killed (it names its process in ``.vares-staging.json``) is removed by the next
-run into the same folder on the same machine; one without that name (a finished run kept beside
-a folder that changed meanwhile) is never removed.
+files of the run and which command wrote them, so the next run knows which files it may
+replace (``--force`` replaces a run of the same command only). The staging folder, and the
+previous run while it is moved aside, name their process in ``.vares-staging.json``: the next
+run into the same folder on the same machine removes those of a process that was killed, and
+puts back a previous run left aside by a process killed in the middle of the swap. A staging
+folder without that name (a finished run kept beside a folder that changed meanwhile) is never
+removed.
 
 Before any work :meth:`OutputFolder.check` refuses what would lose something: an output path
-that is a file, a folder holding files vares did not write (they would be lost), an existing
-run without ``force``, an input among the files to be written, a folder that cannot be written.
+that is a file, the current folder or one containing it, a folder holding files vares did not
+write (they would be lost), an existing run without ``force`` or of another command, an input
+among the files to be written, a folder that cannot be written.
 An input that a previous run wrote into the folder (a job file saved there) is carried over.
 """
 
@@ -27,20 +31,24 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from .._version import __version__
-from ..io.files import OutputExistsError, atomic_path, current_umask
+from ..io.files import OutputExistsError, current_umask, write_text
 
 __all__ = ["MANIFEST", "OutputFolder", "add_to_manifest", "listed"]
 
 #: The file in an output folder that lists what the run wrote.
 MANIFEST = ".vares-run.json"
-#: The file in a staging folder naming the process that writes it (removed before the swap).
+#: The file in a staging folder naming the process that writes it (removed after the swap).
 OWNER = ".vares-staging.json"
+#: The files of an output folder that are not the run's own.
+_BOOKKEEPING = (MANIFEST, OWNER)
 
 
 class OutputFolder:
     """The output folder ``directory`` of a run that will write ``planned`` (paths inside it)
     and reads ``inputs``; see the module docs. A folder inside another run's (``erect/``) has
-    no manifest of its own (``manifest=False``): the files that run lists in it are ``known``."""
+    no manifest of its own (``manifest=False``): the files that run lists in it are ``known``.
+    ``command`` names what writes the folder (``"job"``, ``"evaluate"``): a run of another
+    command is never replaced."""
 
     def __init__(
         self,
@@ -51,6 +59,7 @@ class OutputFolder:
         inputs: Iterable[Path],
         manifest: bool = True,
         known: Iterable[Path] = (),
+        command: str = "job",
     ) -> None:
         self.directory = Path(directory).resolve()
         self.planned = [Path(p).resolve() for p in planned]
@@ -58,6 +67,7 @@ class OutputFolder:
         self.inputs = {Path(p).resolve() for p in inputs}
         self.manifest = manifest
         self.known = {Path(p).resolve() for p in known}
+        self.command = command
         self.staging: Path | None = None
 
     # ------------------------------------------------------------------ before the work
@@ -76,7 +86,20 @@ class OutputFolder:
                 )
         if self.directory.exists() and not self.directory.is_dir():
             raise OutputExistsError(f"the output folder {self.directory} is a file")
+        here = Path.cwd().resolve()
+        if self.directory == here or self.directory in here.parents:
+            raise OutputExistsError(
+                f"the output folder {self.directory} is the current folder or holds it, which "
+                "the run would replace: choose a folder of its own"
+            )
+        _remove_abandoned(self.directory)  # a killed run's leftovers, inside and beside it
         existing = self._existing()
+        other = _command(self.directory)
+        if existing and other not in (None, self.command):
+            raise OutputExistsError(
+                f"the output folder {self.directory} holds a {other} run, which a {self.command} "
+                "run does not replace: choose another folder"
+            )
         self._refuse_foreign(existing)
         if existing and not self.force:
             shown = ", ".join(str(self.directory / p) for p in sorted(existing)[:3])
@@ -105,7 +128,7 @@ class OutputFolder:
         return {
             p.relative_to(self.directory)
             for p in self.directory.rglob("*")
-            if p.is_file() and p.name != MANIFEST
+            if p.is_file() and p.name not in _BOOKKEEPING
         }
 
     def _writable(self) -> None:
@@ -123,11 +146,7 @@ class OutputFolder:
     def start(self) -> Path:
         """Create the staging folder (removing those of killed runs); the run writes into it."""
         _remove_abandoned(self.directory)
-        self.staging = Path(
-            tempfile.mkdtemp(prefix=f".{self.directory.name}.vares-", dir=self.directory.parent)
-        )
-        owner = {"pid": os.getpid(), "host": socket.gethostname()}
-        (self.staging / OWNER).write_text(json.dumps(owner), encoding="utf-8")
+        self.staging = _owned_folder(f".{self.directory.name}.vares-", self.directory.parent)
         planned = set(self.planned)
         for path in self.inputs:  # inputs a previous run wrote here stay with the new run
             if self.directory in path.parents and path not in planned:
@@ -142,29 +161,41 @@ class OutputFolder:
 
     def commit(self) -> None:
         """Put the staged run in place of the output folder (module docs)."""
-        (self.staging / OWNER).unlink(missing_ok=True)
         files = sorted(
-            str(p.relative_to(self.staging)) for p in self.staging.rglob("*") if p.is_file()
+            str(p.relative_to(self.staging))
+            for p in self.staging.rglob("*")
+            if p.is_file() and p.name != OWNER
         )
-        manifest = {"vares_version": __version__, "files": files}
         if self.manifest:
+            manifest = {"vares_version": __version__, "command": self.command, "files": files}
             text = json.dumps(manifest, indent=2) + "\n"
             (self.staging / MANIFEST).write_text(text, encoding="utf-8")
         if self.directory.exists():  # files that appeared during the run are not lost either
-            kept, self.staging = self.staging, None  # not discarded: the run is kept
-            self._refuse_foreign(self._existing(), f"; this run is kept in {kept}")
-            self.staging = kept
+            try:
+                self._refuse_foreign(self._existing(), f"; this run is kept in {self.staging}")
+            except OutputExistsError:
+                (self.staging / OWNER).unlink()  # kept: no later run removes it
+                self.staging = None
+                raise
             shutil.copymode(self.directory, self.staging)
         else:
             os.chmod(self.staging, 0o777 & ~current_umask())
-        previous = None
-        if self.directory.exists():
-            previous = Path(
-                tempfile.mkdtemp(prefix=f".{self.directory.name}.old-", dir=self.directory.parent)
-            )
-            os.replace(self.directory, previous / "run")
-        os.replace(self.staging, self.directory)
+        previous, moved = None, False
+        if self.directory.exists():  # aside, named: a run killed here gets it put back
+            previous = _owned_folder(f".{self.directory.name}.old-", self.directory.parent)
+        try:
+            if previous is not None:
+                os.replace(self.directory, previous / "run")
+                moved = True
+            os.replace(self.staging, self.directory)
+        except BaseException:
+            if moved:
+                os.replace(previous / "run", self.directory)
+            if previous is not None:
+                shutil.rmtree(previous, ignore_errors=True)
+            raise
         self.staging = None
+        (self.directory / OWNER).unlink(missing_ok=True)
         if previous is not None:
             shutil.rmtree(previous, ignore_errors=True)
 
@@ -175,21 +206,50 @@ class OutputFolder:
             self.staging = None
 
 
+def _owned_folder(prefix: str, parent: Path) -> Path:
+    """A new hidden folder in ``parent`` that names this process (:data:`OWNER`)."""
+    folder = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+    owner = {"pid": os.getpid(), "host": socket.gethostname()}
+    (folder / OWNER).write_text(json.dumps(owner), encoding="utf-8")
+    return folder
+
+
 def _remove_abandoned(directory: Path) -> None:
-    """Remove the staging folders beside ``directory`` whose process, on this machine, has
-    ended (killed mid-run: an interrupted run removes its own). POSIX only: elsewhere a process
-    cannot be asked whether it lives without a handle to it."""
+    """Clean up after runs into ``directory`` (and into folders inside it, as ``erect/``) whose
+    process, on this machine, has ended (killed: an interrupted run cleans up itself): remove
+    their staging folders, and put back a previous run they had moved aside and not replaced
+    (else remove it). POSIX only: elsewhere a process cannot be asked whether it lives without
+    a handle to it."""
     if os.name != "posix":
         return
     host = socket.gethostname()
-    for folder in directory.parent.glob(f".{glob.escape(directory.name)}.vares-*"):
+    name = glob.escape(directory.name)
+    staged = [*directory.parent.glob(f".{name}.vares-*")]
+    aside = [*directory.parent.glob(f".{name}.old-*")]
+    if directory.is_dir():
+        staged += directory.glob(".*.vares-*")
+        aside += directory.glob(".*.old-*")
+    for folder in [*staged, *aside]:
         try:
             owner = json.loads((folder / OWNER).read_text(encoding="utf-8"))
             pid, same_host = int(owner["pid"]), owner["host"] == host
         except (OSError, ValueError, KeyError, TypeError):
             continue  # no owner named: a finished run kept beside the folder, or not ours
-        if same_host and pid != os.getpid() and not _alive(pid):
-            shutil.rmtree(folder, ignore_errors=True)
+        if not same_host or pid == os.getpid() or _alive(pid):
+            continue
+        target = folder.parent / folder.name[1:].rsplit(".old-", 1)[0]
+        if folder in aside and (folder / "run").is_dir() and not target.exists():
+            os.replace(folder / "run", target)  # killed between the two renames of the swap
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _command(directory: Path) -> str | None:
+    """The command whose run the folder holds, by its manifest (``None``: no manifest)."""
+    try:
+        data = json.loads((Path(directory) / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data.get("command", "job") if isinstance(data, dict) else None
 
 
 def _alive(pid: int) -> bool:
@@ -211,19 +271,22 @@ def listed(directory: Path) -> list[Path]:
         return []
 
 
-def add_to_manifest(directory: Path, files: Iterable[Path], replacing: Path) -> None:
-    """List files written into a run's folder afterwards (``vares erect``) in its manifest, in
-    place of those it listed in the subfolder ``replacing`` (a rerun may write fewer)."""
+def add_to_manifest(directory: Path, files: Iterable[Path], replacing: Path | None) -> None:
+    """List files written into a run's folder afterwards (``vares erect``) in its manifest: in
+    place of those it listed in the subfolder ``replacing`` (a rerun may write fewer), or
+    beside them (``None``: before the files are put in place, so that a run killed then leaves
+    both the old files and the new ones known)."""
     directory = Path(directory).resolve()
     path = directory / MANIFEST
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         data = {"vares_version": __version__, "files": []}
-    sub = Path(replacing).resolve().relative_to(directory)
-    listed = {f for f in data.get("files", []) if sub not in Path(f).parents}
+    listed = set(data.get("files", []))
+    if replacing is not None:
+        sub = Path(replacing).resolve().relative_to(directory)
+        listed = {f for f in listed if sub not in Path(f).parents}
     listed |= {str(Path(f).resolve().relative_to(directory)) for f in files}
     data["files"] = sorted(listed)
     text = json.dumps(data, indent=2) + "\n"
-    with atomic_path(path) as temporary:
-        temporary.write_text(text, encoding="utf-8")
+    write_text(path, text)

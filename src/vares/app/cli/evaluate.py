@@ -5,13 +5,8 @@ from typing import Annotated, Any
 
 import typer
 
-from ...analysis.evaluate import evaluate as evaluate_pattern
-from ...analysis.statistics import field_statistics
-from ...io.files import write_json
-from ...io.meshes import read_mesh, read_pattern, write_surface
 from ...solver.options import SolveOptions
 from ..sections import MaterialOptions
-from ..staging import OutputFolder
 from .common import console, field_table, guarded
 from .flags import InputError, build, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
@@ -55,6 +50,12 @@ def evaluate(
     """
 
     def body() -> None:
+        from ...analysis.evaluate import evaluate as evaluate_pattern  # when the command runs
+        from ...analysis.statistics import field_statistics
+        from ...io.files import write_json
+        from ...io.meshes import read_mesh, read_pattern, write_surface
+        from ..staging import OutputFolder
+
         material_options = build(MaterialOptions, values)
         fibres = build(SolveOptions, values)
         material = material_options.build(Path.cwd())
@@ -62,7 +63,13 @@ def evaluate(
         coordinates = read_pattern(pattern_file, mesh)
         output = values["output"]
         paths = [output / "evaluation.json", output / "evaluation.vtu"]
-        folder = OutputFolder(output, paths, force=values["force"], inputs=[surface, pattern_file])
+        folder = OutputFolder(
+            output,
+            paths,
+            force=values["force"],
+            inputs=[surface, pattern_file],
+            command="evaluate",
+        )
         folder.check()
         result = evaluate_pattern(
             mesh,
