@@ -254,7 +254,7 @@ def test_a_free_pattern_turns_to_where_turning_the_yarns_costs_nothing():
     held = vares.solve(mesh, NCF, warp_angle=20.0)
     free = vares.solve(mesh, NCF, warp_angle=20.0, orientation="free")
     assert held.converged and free.converged, free.reason
-    assert free.strategy == ["globalised newton"] and free.iterations < 60
+    assert free.strategy == ["globalised newton"] and free.iterations < 40  # 48 not turned further
     # where the projected tangent fell short, the turn was taken further (48 iterations without)
     assert "projected, turned" in {r.tangent for r in free.history}
     assert free.energy < 0.7 * held.energy

@@ -403,3 +403,19 @@ def test_version_and_help():
     assert result.exit_code == 0
     for command in ("pattern", "run", "panels", "cut", "erect", "batch", "--version"):
         assert command in result.stdout
+
+
+def test_plot_writes_each_field_on_the_pattern_and_the_surface(tmp_path):
+    from PIL import Image
+
+    out = tmp_path / "out"
+    result = run("example", "cylinder160", "-o", out, "--plot", "det_F,warp_stress")
+    assert result.exit_code == 0, result.stderr
+    pictures = {}
+    for field in ("det_F", "warp_stress"):
+        for name in (f"pattern_{field}.svg", f"pattern_{field}.png", f"surface_{field}.png"):
+            assert (out / name).stat().st_size > 1000
+        pictures[field] = np.asarray(Image.open(out / f"pattern_{field}.png").convert("RGB"))
+    # one figure re-coloured field after field: the second picture is its own, not the first's
+    assert pictures["det_F"].shape == pictures["warp_stress"].shape
+    assert (pictures["det_F"] != pictures["warp_stress"]).any(axis=-1).mean() > 0.05

@@ -1,6 +1,7 @@
 """Where users reach the erection: --erect on the patterning commands, vares erect DIR, job
 files, and the one options model behind them."""
 
+import base64
 import inspect
 import json
 
@@ -95,11 +96,16 @@ def test_panels_with_erect_weld_the_strips_and_run_again_from_the_saved_job(tmp_
         "5000",
         "--cable-force",
         "20",
+        "--report",
         "-q",
     )
     assert result.exit_code == 0, result.stderr
     data = json.loads((out / "erect" / "erect.json").read_text())
     assert data["converged"] and len(data["panels"]) == 3
+    # the structure's report embeds the erection's pictures as written, not drawn again
+    report = (out / "report.html").read_text()
+    for name in ("deviation.png", "warp_stress.png", "state.png"):
+        assert base64.b64encode((out / "erect" / name).read_bytes()).decode() in report
     assert data["nodes"] == mesh.num_points  # the seams are welded: one node each
     assert data["held_nodes"] == 4 and data["cables"]["force_min"] > 0  # a four-point sail
     job = load_job(out / "job.toml")

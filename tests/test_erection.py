@@ -222,6 +222,8 @@ def test_a_trial_point_whose_state_is_not_found_is_stepped_back_from(monkeypatch
     monkeypatch.setattr(ErectionProblem, "evaluate", once_unfound)
     result = vares.erect(Pattern(mesh, pattern), NeoHooke(E=1000.0, nu=0.3), 0.8, solver=TIGHT)
     assert len(calls) > 2 and result.converged and result.iterations > 1
+    assert result.strategy == ["erection"]  # the line search stepped back: no damped fallback
+    assert result.history[1].step_length < 1.0
     np.testing.assert_allclose(result.erected_points, to_3d(pattern / 0.9), atol=1e-10)
 
 

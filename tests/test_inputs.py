@@ -110,6 +110,9 @@ def test_repair_drops_collapsed_and_duplicate_cells_and_keeps_cell_data_aligned(
     cells = {"triangle": np.array([[0, 1, 2], [0, 2, 3], [2, 0, 1], [4, 1, 0]])}
     fixed = repair(points, cells)
     assert fixed.report.welded_nodes == 1 and fixed.report.collapsed_cells == 1
+    assert fixed.report.unused_nodes == 0  # the welded node is not counted twice
+    stray = repair(np.vstack([points, [[5.0, 5.0, 0.0]]]), cells)  # a node of no cell
+    assert stray.report.welded_nodes == 1 and stray.report.unused_nodes == 1
     assert fixed.report.duplicate_cells == 1
     np.testing.assert_array_equal(fixed.cell_map, [0, 1])
     assert len(fixed.points) == 4
@@ -371,3 +374,16 @@ def test_zero_area_cells_are_dropped_only_on_the_boundary_of_the_whole_mesh():
     cells = {"quad": np.array([*quads, [5, 6, 10, 9], [13, 7, 3, 12]])}
     fixed = repair(points, cells)
     assert fixed.report.flat_boundary_cells == 0 and len(fixed.cells["quad"]) == 7
+
+
+def test_a_soup_knows_which_file_face_each_of_its_cells_is(tmp_path):
+    """Faces of mixed sizes are sorted into triangles, quads and polygons: ``order`` carries a
+    per-face value of the file (a DXF face's layer) to the right cell."""
+    from vares.io.formats import _soup
+
+    points = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 1.5, 0]]
+    faces = [[0, 1, 2, 3], [0, 1, 2], [0, 1, 2, 4, 3], [0, 2, 3], [0, 1]]  # the last: a line
+    soup = _soup(points, faces, tmp_path / "mixed")
+    np.testing.assert_array_equal(soup.order, [1, 3, 0, 2])
+    np.testing.assert_array_equal(soup.cells["triangle"], [faces[1], faces[3]])
+    np.testing.assert_array_equal(soup.cells["quad"], [faces[0]])

@@ -1,5 +1,6 @@
 """Files for the cutter and for people: DXF, Rhino 3dm, drawings, the HTML report, job files."""
 
+import base64
 import json
 import shutil
 import subprocess
@@ -184,8 +185,9 @@ def _unwelded_3dm(path, objects):
 def test_rhino_meshes_with_a_vertex_per_face_at_seams_are_welded(tmp_path):
     roof = vares.examples.hypar(n=8)
     path = _unwelded_3dm(tmp_path / "roof.3dm", [("roof", roof)])
-    with pytest.warns(UserWarning, match=r"welded 9 node\(s\)"):
+    with pytest.warns(UserWarning, match=r"welded 9 node\(s\)") as said:
         mesh = vares.read_mesh(path)
+    assert "belong to no cell" not in str(said[0].message)  # welded, not also "unused"
     assert mesh.num_points == roof.num_points and len(mesh.boundary_loops()) == 1
     result = run("pattern", path, "-o", tmp_path / "out", "-q")
     assert result.exit_code == 0, result.stderr
@@ -219,7 +221,6 @@ def test_report_pictures_are_drawn_at_the_reports_resolution(tmp_path):
     """The report's own pictures are PNGs at its 100 dpi (a 6.5-inch field map is 650 pixels
     wide, a 7-inch view 700) whose cells are opaque colours, not the 150-dpi files'; the pattern
     is the run's own pattern.png, embedded as it is."""
-    import base64
     import gc
     import io
     import re
@@ -329,6 +330,14 @@ def test_pattern_outputs_drawings_and_report_in_a_browser(tmp_path):
         *(f"figure-erection-{k}" for k in range(6)),
     ):
         assert f'id="{figure}"' in dom
+    # the erected pictures embedded as erect/ holds them (0, 2, 4, 5), the design shape's drawn
+    html = (out / "report.html").read_text()
+    for k, name in ((0, "deviation.png"), (2, "warp_stress.png"), (5, "state.png")):
+        png = base64.b64encode((out / "erect" / name).read_bytes()).decode("ascii")
+        assert (
+            f'id="figure-erection-{k}"><img alt="' in html
+            and png in html.split(f'id="figure-erection-{k}"')[1].split("</figure>")[0]
+        )
     # the erection section: design shape against erected, the numbers of erect.json
     erected = json.loads((out / "erect" / "erect.json").read_text())
     comparison = dom.split('id="erection-comparison"')[1].split("</table>")[0]

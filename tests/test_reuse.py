@@ -71,7 +71,7 @@ def test_cg_gives_up_on_an_indefinite_matrix_and_beyond_its_budget():
     assert x is None  # negative curvature met, not iterated through
     # unpreconditioned CG on a Laplacian converges slowly: its rate shows it early
     x, iterations = preconditioned_cg(_laplacian(30, 1e-3), np.ones(900), lambda r: r, 1e-10, 8)
-    assert x is None and iterations <= 8
+    assert x is None and iterations <= 3  # given up once the rate shows it, not at the budget
     zero, iterations = preconditioned_cg(matrix, np.zeros(matrix.shape[0]), lambda r: r, 1e-8, 5)
     assert iterations == 0 and not zero.any()
 
@@ -189,7 +189,7 @@ def test_globalised_newton_takes_the_projected_tangent_where_the_exact_one_is_re
     result = _solve_with(mesh, _DefiniteOnly())
     assert result.converged and _DefiniteOnly.refused > 0
     tangents = {r.tangent for r in result.history[1:]}
-    assert "projected" in tangents
+    assert "exact" not in tangents and "projected" in tangents
     assert result.energy == pytest.approx(reference.energy, rel=1e-10)
 
 

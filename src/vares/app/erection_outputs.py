@@ -19,7 +19,7 @@ from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path, write_json
 from ..io.meshes import write_surface
 
-__all__ = ["ERECTION_FILES", "erection_files", "write_erection"]
+__all__ = ["ERECTION_FILES", "erected_pictures", "erection_files", "write_erection"]
 
 #: The files of an erection, in the output directory's ``erect/``.
 ERECTION_FILES = (
@@ -36,6 +36,21 @@ ERECTION_FILES = (
 def erection_files(directory: Path, report: bool = False) -> list[Path]:
     """The files an erection writes into ``directory``."""
     return [directory / n for n in ERECTION_FILES + (("report.html",) if report else ())]
+
+
+def erected_pictures(result: ErectionResult, units: str) -> dict[str, tuple[str, np.ndarray, str]]:
+    """The pictures an erection writes, of the erected shape: field → (file, per-cell values,
+    title); a report embeds them as written."""
+    per_cell = np.concatenate(
+        [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
+    )
+    after = result.fields
+    return {
+        "normal_deviation": ("deviation.png", per_cell, f"normal deviation from design ({units})"),
+        "warp_stress": ("warp_stress.png", after["warp_stress"], "warp force, erected"),
+        "fill_stress": ("fill_stress.png", after["fill_stress"], "fill force, erected"),
+        "state": ("state.png", after["state"], "taut (0) / wrinkled (1) / slack (2), erected"),
+    }
 
 
 def write_erection(result: ErectionResult, directory: Path, units: str) -> list[Path]:
@@ -59,19 +74,10 @@ def write_erection(result: ErectionResult, directory: Path, units: str) -> list[
     for name, writer in writers.items():
         writer(directory / name)
         files.append(directory / name)
-    erected = result.erected_mesh
-    per_cell = np.concatenate(
-        [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
-    )
     scale = result.material.stiffness_scale * result.thickness
-    drawings = {  # field: file, values, title
-        "normal_deviation": ("deviation.png", per_cell, f"normal deviation ({units})"),
-        "warp_stress": ("warp_stress.png", result.fields["warp_stress"], "warp force, erected"),
-        "fill_stress": ("fill_stress.png", result.fields["fill_stress"], "fill force, erected"),
-        "state": ("state.png", result.fields["state"], "taut / wrinkled / slack, erected"),
-    }
+    drawings = erected_pictures(result, units)
     pictures = plot_surface_fields(  # on one figure
-        erected,
+        result.erected_mesh,
         {field: values for field, (_, values, _) in drawings.items()},
         titles={field: title for field, (_, _, title) in drawings.items()},
         stress_unit="force/length",

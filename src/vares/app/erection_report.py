@@ -10,12 +10,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from ..analysis.erection import ErectionResult
-from ..io.files import atomic_path
+from ..io.files import write_text
+from .erection_outputs import erected_pictures
 from .html_parts import (
-    DPI,
+    REPORT_DPI,
     figure,
     number,
     page,
@@ -76,24 +75,26 @@ def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[
     others drawn, those of each shape on one figure (:func:`~vares.io.plot.plot_surface_fields`)."""
     from ..io.plot import plot_surface_fields
 
-    erected = result.erected_mesh
     scale = result.material.stiffness_scale * result.thickness
-    per_cell = np.concatenate(
-        [result.normal_deviation[c].mean(axis=1) for c in result.mesh.cells.values()]
-    )
-    design, after = result.design_fields, result.fields
-    drawings = [  # the file an erection writes of the same picture, if it writes one
-        ("deviation.png", "erected", per_cell, "normal_deviation", "normal deviation from design"),
-        (None, "design", design["warp_stress"], "warp_stress", "warp force on the design shape"),
-        ("warp_stress.png", "erected", after["warp_stress"], "warp_stress", "warp force, erected"),
-        (None, "design", design["fill_stress"], "fill_stress", "fill force on the design shape"),
-        ("fill_stress.png", "erected", after["fill_stress"], "fill_stress", "fill force, erected"),
-        ("state.png", "erected", after["state"], "state", "taut (0) / wrinkled (1) / slack (2)"),
-    ]  # fmt: skip
+    written = erected_pictures(result, units)  # (file, values, title) by field
+    design = {
+        yarn: (None, result.design_fields[yarn], f"{yarn[:4]} force on the design shape")
+        for yarn in ("warp_stress", "fill_stress")
+    }
+    order = [  # (shape, field): the design shape's yarn forces beside the erected ones
+        ("erected", "normal_deviation"),
+        ("design", "warp_stress"),
+        ("erected", "warp_stress"),
+        ("design", "fill_stress"),
+        ("erected", "fill_stress"),
+        ("erected", "state"),
+    ]
+    drawings = [
+        (*(written if shape == "erected" else design)[field], shape, field)
+        for shape, field in order
+    ]
     embedded, fields, titles = {}, {"design": {}, "erected": {}}, {"design": {}, "erected": {}}
-    for k, (name, shape, values, field, caption) in enumerate(drawings):
-        if name == "deviation.png":
-            caption = f"{caption} ({units})"
+    for k, (name, values, caption, shape, field) in enumerate(drawings):
         if pictures is not None and name is not None and (pictures / name).is_file():
             embedded[k] = picture(pictures / name, caption, f"figure-erection-{k}")
         else:  # a shape's fields are distinct
@@ -105,12 +106,12 @@ def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[
             titles=titles[shape],
             stress_unit="force/length",
             stress_scale=scale,
-            dpi=DPI,
+            dpi=REPORT_DPI,
         )
-        for shape, mesh in (("design", result.mesh), ("erected", erected))
+        for shape, mesh in (("design", result.mesh), ("erected", result.erected_mesh))
     }
     out = []
-    for k, (_, shape, _, field, _) in enumerate(drawings):
+    for k, (_, _, _, shape, field) in enumerate(drawings):
         if k in embedded:
             out.append(embedded[k])
             continue
@@ -174,6 +175,5 @@ def write_erection_report(result: ErectionResult, directory: Path, units: str) -
     with report_drawing():
         parts += [*erection_section(result, units, Path(directory)), "</body></html>"]
     path = Path(directory) / "report.html"
-    with atomic_path(path) as temporary:
-        temporary.write_text("\n".join(parts), encoding="utf-8")
+    write_text(path, "\n".join(parts))
     return path

@@ -14,7 +14,7 @@ from pathlib import Path
 from .._version import __version__
 
 __all__ = [
-    "DPI",
+    "REPORT_DPI",
     "STYLE",
     "figure",
     "number",
@@ -27,7 +27,7 @@ __all__ = [
 
 #: Resolution of the pictures drawn into a report (a 6.5-inch figure is 650 pixels wide, shown at
 #: most 520): pass it to the plots, which rasterise the cells for it.
-DPI = 100
+REPORT_DPI = 100
 #: zlib level of the embedded PNGs. A 100k-cell field on the pattern at 100 dpi, level 6
 #: (Pillow's default) → 4 → 1: 41 → 20 → 15 ms, 157 → 171 → 203 KiB; a 4.6k-cell one 17 → 14 →
 #: 11 ms, 89 → 94 → 111 KiB. Level 4 takes most of the time off for a file 5–9 % larger.
@@ -69,7 +69,8 @@ def _png(fig, close: bool) -> str:
     import matplotlib.pyplot as plt
 
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=DPI, pil_kwargs={"compress_level": _COMPRESS_LEVEL})
+    options = {"compress_level": _COMPRESS_LEVEL}
+    fig.savefig(buffer, format="png", dpi=REPORT_DPI, pil_kwargs=options)
     if close:
         plt.close(fig)
     return base64.b64encode(buffer.getvalue()).decode("ascii")

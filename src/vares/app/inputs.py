@@ -13,6 +13,7 @@ import numpy as np
 from ..analysis.erection_model import Pattern
 from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, PANEL_NAMES, STRUCTURE_EXAMPLES
 from ..geometry.mesh import MeshError
+from ..geometry.repair import RepairReport
 from ..io.meshes import MeshFile, read_mesh, read_mesh_data, read_mesh_file, read_pattern
 from ..io.rhino import read_3dm, unit_system
 from ..materials import Fibres
@@ -85,13 +86,16 @@ def _units(job: Job, declared: list[str | None]) -> str:
     return next(iter(named), given or DEFAULT_UNITS)
 
 
+def _note_repair(loaded: Input, label: str, report: RepairReport) -> None:
+    """Say what the repair of ``label`` (a file, or an object of one) changed, if anything."""
+    if report.changed:
+        loaded.repairs[label] = report.to_dict()
+        loaded.warnings.append(f"repaired {label}: {'; '.join(report.actions())}")
+
+
 def _note(loaded: Input, files: list[MeshFile]) -> None:
     for mesh_file in files:
-        if mesh_file.repair.changed:
-            loaded.repairs[mesh_file.path.name] = mesh_file.repair.to_dict()
-            loaded.warnings.append(
-                f"repaired {mesh_file.path.name}: {'; '.join(mesh_file.repair.actions())}"
-            )
+        _note_repair(loaded, mesh_file.path.name, mesh_file.repair)
         precision = mesh_file.precision_warning()
         if precision is not None:
             loaded.warnings.append(precision)
@@ -125,11 +129,7 @@ def _structure(job: Job) -> Input:
         panels = [Panel(m.name, m.mesh) for m in meshes]
         loaded = Input(panels, _units(job, [unit_system(paths[0])]))
         for m in meshes:
-            if m.repair.changed:
-                loaded.repairs[f"{paths[0].name}: {m.name}"] = m.repair.to_dict()
-                loaded.warnings.append(
-                    f"repaired {paths[0].name}, object {m.name!r}: {'; '.join(m.repair.actions())}"
-                )
+            _note_repair(loaded, f"{paths[0].name}, object {m.name!r}", m.repair)
     elif len(paths) > 1:
         files = [_read(job, p) for p in paths]
         panels = [Panel(f.path.stem, f.surface()) for f in files]

@@ -34,7 +34,7 @@ import numpy as np
 from .._version import __version__
 from ..analysis.statistics import field_statistics
 from ..io.dxf import CutPiece, write_dxf
-from ..io.files import atomic_path, write_json
+from ..io.files import atomic_path, write_bytes, write_json, write_text
 from ..io.meshes import write_surface
 from ..io.sketch import DPI, pattern_sketch
 from ..io.summary import summary
@@ -116,8 +116,7 @@ def write_job_file(job: Job, directory: Path) -> Path:
     ran, paths relative to the output directory."""
     text = job.to_toml(job.directory / JOB_FILE)
     path = directory / JOB_FILE
-    with atomic_path(path) as temporary:
-        temporary.write_text(text, encoding="utf-8")
+    write_text(path, text)
     return path
 
 
@@ -232,52 +231,31 @@ def _write_drawings(panel: PanelOutcome, job: Job, material_scale: float) -> Non
         sketch = pattern_sketch(
             mesh, x, fibres=result.fibres, title=f"{panel.name}: pattern", marks=crossings
         )
-        for name, content in (("pattern.svg", sketch.svg()), ("pattern.png", sketch.png(DPI))):
-            path = panel.directory / name
-            with atomic_path(path) as temporary:
-                if isinstance(content, str):
-                    temporary.write_text(content, encoding="utf-8")
-                else:
-                    temporary.write_bytes(content)
-            panel.files.append(path)
+        svg, png = PREVIEW_FILES
+        _write(panel, svg, lambda path: write_text(path, sketch.svg()))
+        _write(panel, png, lambda path: write_bytes(path, sketch.png(DPI)))
     if not job.output.plots:
         return  # matplotlib is not even imported
-    import matplotlib.pyplot as plt
+    from ..io.plot import plot_pattern_fields, plot_surface_fields
 
-    from ..io.plot import plot_pattern, plot_surface
-
-    def save(fig, names: tuple[str, ...]) -> None:
-        for name in names:
-            path = panel.directory / name
-            with atomic_path(path) as temporary:
-                fig.savefig(temporary, dpi=DPI)
-            panel.files.append(path)
-        plt.close(fig)
-
-    unit = "force/length" if result.thickness == 1.0 else "stress"
-    scale = material_scale * result.thickness
-    for name in job.output.plots:
-        values = result.fields[name]
-        title = f"{panel.name}: {name} on the design shape"
-        save(
-            plot_pattern(
-                mesh,
-                x,
-                values,
-                field=name,
-                fibres=result.fibres,
-                stress_unit=unit,
-                stress_scale=scale,
-                title=title,
-            ),
-            (f"pattern_{name}.svg", f"pattern_{name}.png"),
-        )
-        save(
-            plot_surface(
-                mesh, values, field=name, stress_unit=unit, stress_scale=scale, title=title
-            ),
-            (f"surface_{name}.png",),
-        )
+    fields = {name: result.fields[name] for name in job.output.plots}
+    titles = {name: f"{panel.name}: {name} on the design shape" for name in fields}
+    style = {
+        "stress_unit": "force/length" if result.thickness == 1.0 else "stress",
+        "stress_scale": material_scale * result.thickness,
+        "titles": titles,
+    }
+    pictures = [  # each set of figures shares one rasterisation of the cells
+        (plot_pattern_fields(mesh, x, fields, fibres=result.fibres, **style), ("svg", "png")),
+        (plot_surface_fields(mesh, fields, **style), ("png",)),
+    ]
+    for (drawings, suffixes), prefix in zip(pictures, ("pattern", "surface"), strict=True):
+        for name, fig in drawings:
+            for suffix in suffixes:
+                path = panel.directory / f"{prefix}_{name}.{suffix}"
+                with atomic_path(path) as temporary:
+                    fig.savefig(temporary, dpi=DPI)
+                panel.files.append(path)
 
 
 def structure_marks(outcome: JobOutcome) -> list[np.ndarray]:

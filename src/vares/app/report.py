@@ -13,18 +13,17 @@ from __future__ import annotations
 
 import html
 import os
-from pathlib import Path
 
 import numpy as np
 
 from ..analysis.statistics import field_statistics
-from ..io.files import atomic_path
+from ..io.files import write_text
 from ..materials import Hyperelastic
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
 from ..solver.linear import solver_choice
 from .erection_report import erection_section
 from .html_parts import (
-    DPI,
+    REPORT_DPI,
     figure,
     number,
     page,
@@ -169,7 +168,7 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
 
     result, mesh, fields = outcome.result, outcome.mesh, outcome.result.fields
     x = result.material_coordinates
-    image = pattern_image(mesh, x, DPI)  # the cells rasterised once for every picture of x
+    image = pattern_image(mesh, x, REPORT_DPI)  # the cells rasterised once for every picture of x
     scale = material.stiffness_scale * result.thickness
     crossings = None if result.overlap is None else result.overlap.crossings
     caption = "the pattern with warp and fill"
@@ -205,7 +204,7 @@ def _pattern_figures(outcome: PanelOutcome, material: Hyperelastic) -> list[str]
         {name: fields[name] for name in titles},
         titles=titles,
         stress_scale=scale,
-        dpi=DPI,
+        dpi=REPORT_DPI,
     )
     parts.append("<h2>On the design surface</h2>")
     for name, drawing in surfaces:
@@ -300,7 +299,11 @@ def structure_report(outcome: JobOutcome) -> str:
             ident="seams",
         ),
         *(_cut_section(outcome) if outcome.cut is not None else []),
-        *(erection_section(outcome.erection, units) if outcome.erection is not None else []),
+        *(
+            erection_section(outcome.erection, units, outcome.directory / "erect")
+            if outcome.erection is not None
+            else []
+        ),
         "</body></html>",
     ]
     return "\n".join(parts)
@@ -329,7 +332,7 @@ def _cut_section(outcome: JobOutcome) -> list[str]:
             ("yield", f"{100 * nest.yield_:.1f} % (waste {100 * nest.waste:.1f} %)"),
         ]
     parts = ["<h2>Cutting and nesting</h2>", table(key, ident="cut-figures")]
-    lines = plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines, dpi=DPI)
+    lines = plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines, dpi=REPORT_DPI)
     parts.append(figure(lines, "cutting lines on the surface", "cut-lines"))
     if nest is not None:
         drawing = plot_nest(nest.roll_width, nest.length, nested_drawings(outcome), units=units)
@@ -343,15 +346,10 @@ def write_reports(outcome: JobOutcome) -> None:
     with report_drawing():
         for panel in outcome.panels:
             path = panel.directory / "report.html"
-            _write_text(path, html_report(panel, outcome))
+            write_text(path, html_report(panel, outcome))
             panel.files.append(path)
             outcome.files.append(path)
         if outcome.structure is not None:
             path = outcome.directory / "report.html"
-            _write_text(path, structure_report(outcome))
+            write_text(path, structure_report(outcome))
             outcome.files.append(path)
-
-
-def _write_text(path: Path, text: str) -> None:
-    with atomic_path(path) as temporary:
-        temporary.write_text(text, encoding="utf-8")

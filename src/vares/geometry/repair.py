@@ -150,7 +150,8 @@ def repair(
         used[block.ravel()] = True
     renumber = np.full(len(points), -1, dtype=np.int64)
     renumber[used] = np.arange(used.sum())
-    counts["unused_nodes"] = int((~used).sum())
+    # the nodes welded onto others are unused now: counted as welded, not again as unused
+    counts["unused_nodes"] = int((~used).sum()) - counts.get("welded_nodes", 0)
     kept = {t: renumber[b] for t, b in blocks.items() if len(b)}
     cell_map = np.concatenate([owners[t] for t in kept]) if kept else np.zeros(0, int)
     return Repaired(points[used], kept, cell_map, RepairReport(**counts))

@@ -16,7 +16,16 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputExistsError", "atomic_path", "check_writable", "current_umask", "write_json"]
+__all__ = [
+    "OutputExistsError",
+    "atomic_path",
+    "check_writable",
+    "current_umask",
+    "write_bytes",
+    "write_json",
+    "write_text",
+    "write_with",
+]
 
 
 class OutputExistsError(FileExistsError):
@@ -60,6 +69,16 @@ def write_with(path: Path, writer: Callable[[Path], None]) -> None:
         writer(temporary)
 
 
+def write_text(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) atomically."""
+    write_with(Path(path), lambda p: p.write_text(text, encoding="utf-8"))
+
+
+def write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` atomically."""
+    write_with(Path(path), lambda p: p.write_bytes(data))
+
+
 def write_json(path: Path, data: dict) -> None:
     """Write ``data`` as indented JSON (numpy scalars and arrays converted)."""
 
@@ -70,5 +89,4 @@ def write_json(path: Path, data: dict) -> None:
             return value.item()
         raise TypeError(f"cannot write {type(value).__name__} to JSON")
 
-    text = json.dumps(data, indent=2, default=default, allow_nan=True) + "\n"
-    write_with(Path(path), lambda p: p.write_text(text, encoding="utf-8"))
+    write_text(path, json.dumps(data, indent=2, default=default, allow_nan=True) + "\n")

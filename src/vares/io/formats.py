@@ -22,12 +22,14 @@ __all__ = ["DXF_UNITS", "PolygonSoup", "read_dxf", "read_obj", "read_off"]
 
 @dataclass
 class PolygonSoup:
-    """Points ``(n, 3)``, faces by size, and the per-face order of the file: face ``k`` of the
-    file is ``order[k]`` in the block-by-block numbering (triangles, quads, polygons)."""
+    """Points ``(n, 3)``, faces by size, and for each face in the block-by-block numbering
+    (triangles, quads, polygons) the number of the file's face it is (``order``, to carry a
+    per-face value of the file along)."""
 
     points: np.ndarray
     cells: dict[str, np.ndarray] = field(default_factory=dict)
     polygons: list[np.ndarray] = field(default_factory=list)
+    order: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 def _soup(points: list[list[float]], faces: list[list[int]], path: Path) -> PolygonSoup:
@@ -36,6 +38,7 @@ def _soup(points: list[list[float]], faces: list[list[int]], path: Path) -> Poly
     coordinates = np.array(points, dtype=float)
     n = len(coordinates)
     triangles, quads, polygons = [], [], []
+    numbers: tuple[list[int], list[int], list[int]] = ([], [], [])
     for number, face in enumerate(faces, start=1):
         if len(face) < 3:
             continue  # a point or a line, not a surface cell
@@ -46,7 +49,9 @@ def _soup(points: list[list[float]], faces: list[list[int]], path: Path) -> Poly
                 f"but the file has {n} vertices"
             )
         face = [i % n for i in face]
-        (triangles if len(face) == 3 else quads if len(face) == 4 else polygons).append(face)
+        kind = min(len(face), 5) - 3  # triangles, quads, polygons
+        (triangles, quads, polygons)[kind].append(face)
+        numbers[kind].append(number - 1)
     if not (triangles or quads or polygons):
         raise MeshError(f"{path} contains no triangle or quad cells")
     cells = {}
@@ -54,7 +59,8 @@ def _soup(points: list[list[float]], faces: list[list[int]], path: Path) -> Poly
         cells["triangle"] = np.array(triangles, dtype=np.int64)
     if quads:
         cells["quad"] = np.array(quads, dtype=np.int64)
-    return PolygonSoup(coordinates, cells, [np.array(p, dtype=np.int64) for p in polygons])
+    order = np.array([*numbers[0], *numbers[1], *numbers[2]], dtype=np.int64)
+    return PolygonSoup(coordinates, cells, [np.array(p, dtype=np.int64) for p in polygons], order)
 
 
 def _numbers(tokens: list[str], path: Path, line: int, kind=float) -> list:
@@ -208,8 +214,6 @@ def read_dxf(path: Path) -> tuple[PolygonSoup, str | None, np.ndarray, list[str]
             f"{path} declares its units as {unit_name(code)} ($INSUNITS {code}); vares knows "
             f"{', '.join(DXF_UNITS.values())}: change the drawing's units"
         )
-    sizes = np.array([len(face) for face in faces])
-    kept = np.flatnonzero(sizes >= 3)  # the soup's order: triangles, quads, polygons
-    order = kept[np.argsort(np.minimum(sizes[kept], 5), kind="stable")]
-    layer = np.array(layer_of_face, dtype=np.int64)[order]
-    return _soup(points, faces, path), DXF_UNITS.get(code), layer, list(layers)
+    soup = _soup(points, faces, path)
+    layer = np.array(layer_of_face, dtype=np.int64)[soup.order]
+    return soup, DXF_UNITS.get(code), layer, list(layers)

@@ -226,15 +226,16 @@ def _read_meshio(path: Path) -> RawSurface:
     import meshio
 
     strings, source = {}, path
+    folder = contextlib.ExitStack()  # a copy without string arrays, removed once read
     if path.suffix.lower() == ".vtu":
         stripped, strings = split_string_fields(path.read_bytes())
         if strings:  # meshio refuses string arrays: it reads the file without them
-            folder = tempfile.TemporaryDirectory()
-            source = Path(folder.name) / path.name
+            source = Path(folder.enter_context(tempfile.TemporaryDirectory())) / path.name
             source.write_bytes(stripped)
     chatter = io.StringIO()  # some readers print their complaints: keep them for the error
     try:
         with (
+            folder,
             warnings.catch_warnings(),
             contextlib.redirect_stdout(chatter),
             contextlib.redirect_stderr(chatter),

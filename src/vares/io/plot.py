@@ -21,7 +21,7 @@ from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres
 from ..mechanics.fields import FIELD_DESCRIPTIONS
 from .raster import CellImage, View, rasterise
-from .sketch import DPI, FACE, MESH, MESH_LINES_UP_TO
+from .sketch import DPI, FACE, MARGINS, MESH, MESH_LINES_UP_TO, SIDE, fibre_arrow_length
 
 __all__ = [
     "DPI",
@@ -118,12 +118,9 @@ def _colour_scale(values, field, value_range, stress_scale):
     return Normalize(low, high if high > low else low + 1e-12), "viridis"
 
 
-_FACE, _LINES = FACE, MESH  # as the run's preview (sketch.py)
-
-
 #: Fixed margins of a picture, inches: left, right, bottom, top (room for a title, tick labels
 #: and axis labels; a colour bar takes its room from the axes).
-_MARGINS = (0.7, 0.25, 0.45, 0.4)
+_MARGINS = MARGINS  # as the run's preview (sketch.py)
 
 
 def _figure(size: tuple[float, float], margins: tuple[float, float, float, float] = _MARGINS):
@@ -193,7 +190,7 @@ def _pattern_size(coordinates: np.ndarray) -> tuple[float, float]:
     pattern's longer side, a colour bar beside it."""
     width, height = np.ptp(coordinates, axis=0)
     aspect = float(np.clip(height / width, 0.3, 3.0)) if width > 0 else 1.0
-    return (6.5, 6.5 * aspect * 0.85 + 0.6) if aspect <= 1 else (6.5 / aspect + 1.5, 6.5)
+    return (SIDE, SIDE * aspect * 0.85 + 0.6) if aspect <= 1 else (SIDE / aspect + 1.5, SIDE)
 
 
 def pattern_image(mesh: SurfaceMesh, coordinates: np.ndarray, dpi: float = DPI) -> CellImage:
@@ -312,10 +309,10 @@ def _draw_pattern(
         image = rasterise(mesh.cells, coordinates, pixels=_pixels(ax, dpi))
     fig = ax.figure
     if values is None:
-        _cells(ax, image, np.broadcast_to(_bytes(to_rgba(_FACE)), (mesh.num_cells, 4)))
+        _cells(ax, image, np.broadcast_to(_bytes(to_rgba(FACE)), (mesh.num_cells, 4)))
         if mesh.num_cells <= MESH_LINES_UP_TO:
             lines = LineCollection(
-                coordinates[mesh.edges()], colors=_LINES, linewidths=0.2, rasterized=True
+                coordinates[mesh.edges()], colors=MESH, linewidths=0.2, rasterized=True
             )
             ax.add_collection(lines)
     else:
@@ -334,7 +331,7 @@ def _draw_pattern(
         ax.plot(*np.asarray(marks).T, "o", mfc="none", mec="red", ms=9, mew=1.5, ls="none")
     if fibres is not None:
         centre = coordinates.mean(axis=0)
-        size = 0.15 * np.ptp(coordinates, axis=0).max()
+        size = fibre_arrow_length(coordinates)
         for direction, style, name in ((fibres.warp, "-", "warp"), (fibres.fill, "--", "fill")):
             ax.annotate(
                 "",
@@ -354,6 +351,7 @@ def plot_pattern_fields(
     coordinates: np.ndarray,
     fields: Mapping[str, np.ndarray],
     *,
+    titles: Mapping[str, str] | None = None,
     fibres: Fibres | None = None,
     stress_unit: str = "stress",
     stress_scale: float | None = None,
@@ -361,11 +359,11 @@ def plot_pattern_fields(
     image: CellImage | None = None,
 ) -> Iterator[tuple[str, plt.Figure]]:
     """:func:`plot_pattern` of each of ``fields`` (name → per-cell values) in turn, titled by
-    its name, as ``(name, figure)``: one figure, its axes, outline, arrows and colour bar made
-    once, that each field re-colours (cells, colour bar, label, title). Each picture is, to the
-    byte, :func:`plot_pattern`'s own of that field, for a quarter less work (a report draws
-    five); but the figure is the same, so save it before taking the next. It is closed at the
-    end."""
+    ``titles`` (by name; else the name), as ``(name, figure)``: one figure, its axes, outline,
+    arrows and colour bar made once, that each field re-colours (cells, colour bar, label,
+    title). Each picture is, to the byte, :func:`plot_pattern`'s own of that field, for a
+    quarter less work (a report draws five); but the figure is the same, so save it before
+    taking the next. It is closed at the end."""
 
     def draw(name: str, values: np.ndarray, title: str) -> _Drawn:
         return _draw_pattern(
@@ -374,7 +372,7 @@ def plot_pattern_fields(
             marks=None, dpi=dpi, image=image,
         )  # fmt: skip
 
-    return _each_field(fields, None, draw, stress_scale, stress_unit)
+    return _each_field(fields, titles, draw, stress_scale, stress_unit)
 
 
 def save_pattern_figure(path, *args, dpi: float = DPI, **kwargs) -> None:
@@ -476,7 +474,7 @@ def _draw_surface(
     seen = _SurfaceView(mesh, ax, view, dpi)
     drawn = None
     if values is None:
-        seen.cells(np.tile(to_rgba(_FACE), (mesh.num_cells, 1)))
+        seen.cells(np.tile(to_rgba(FACE), (mesh.num_cells, 1)))
     else:
         values = np.asarray(values, dtype=float)
         shown, label = _field_scale(values, field, None, stress_scale, stress_unit)

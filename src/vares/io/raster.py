@@ -114,16 +114,23 @@ def rasterise(
     coordinates: np.ndarray,
     depth: np.ndarray | None = None,
     pixels: int = PIXELS,
+    grid: tuple[float, float, float, int, int] | None = None,
 ) -> CellImage:
     """The index image of the ``cells`` (blocks by type, as ``SurfaceMesh.cells``) drawn at
     node ``coordinates`` ``(n, 2)``: the nearest cell in front where ``depth`` ``(n,)`` is
-    given, else any of those covering a pixel."""
+    given, else any of those covering a pixel. The image spans the cells with ``pixels``
+    along its longer side, or is the pixel ``grid`` ``(x0, y0, side, columns, rows)`` given
+    (a picture's own: row ``j`` covers ``y0 + j·side`` to ``y0 + (j + 1)·side``)."""
     coordinates = np.asarray(coordinates, dtype=float)
-    low, high = coordinates.min(axis=0), coordinates.max(axis=0)
-    span = float(np.max(high - low)) or 1.0
-    h = span / pixels
-    low = low - h  # one pixel of margin around the drawing
-    columns, rows = (np.ceil((high - low) / h).astype(int) + 2).tolist()
+    if grid is None:
+        low, high = coordinates.min(axis=0), coordinates.max(axis=0)
+        span = float(np.max(high - low)) or 1.0
+        h = span / pixels
+        low = low - h  # one pixel of margin around the drawing
+        columns, rows = (np.ceil((high - low) / h).astype(int) + 2).tolist()
+    else:
+        x0, y0, h, columns, rows = grid
+        low = np.array([x0, y0], dtype=float)
     index = np.full((rows, columns), -1, dtype=np.int64)
     buffer = np.full((rows, columns), np.inf)
     triangles, owners = triangles_of(cells)

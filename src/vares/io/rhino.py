@@ -202,5 +202,8 @@ def write_3dm(path: str | Path, meshes: list[NamedMesh], units: str | None = Non
         attributes.Name = named.name
         attributes.LayerIndex = layer_index[layer_name]
         model.Objects.AddMesh(mesh, attributes)
-    if not model.Write(str(path), 7):
-        raise OSError(f"could not write {path}")
+    from .files import atomic_path
+
+    with atomic_path(Path(path)) as temporary:
+        if not model.Write(str(temporary), 7):
+            raise OSError(f"could not write {path}")

@@ -13,28 +13,37 @@ from __future__ import annotations
 
 import io
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from html import escape
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
-from ..geometry.mesh import MeshError, SurfaceMesh
+from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres
 
-__all__ = ["DPI", "MESH_LINES_UP_TO", "Sketch", "nice_ticks", "pattern_sketch"]
+__all__ = [
+    "DPI",
+    "MARGINS",
+    "MESH_LINES_UP_TO",
+    "SIDE",
+    "Sketch",
+    "fibre_arrow_length",
+    "nice_ticks",
+    "pattern_sketch",
+]
 
 #: Resolution of the pictures a run writes (``pattern.png``, ``surface_FIELD.png``, …): the
 #: cells of a picture are rasterised for it unless a plot is given another ``dpi``.
 DPI = 150
-
-#: The longer side of a preview, points (1/72 inch), as matplotlib's 6.5-inch figures.
-SIDE = 468.0
-#: Margins around the axes, points: left, right, bottom, top (tick labels, title).
-MARGINS = (50.0, 18.0, 32.0, 29.0)
 #: Points per inch.
 POINT = 72.0
+#: The longer side of a picture of a pattern, inches (the preview here, matplotlib's in plot.py).
+SIDE = 6.5
+#: Margins around the axes, inches: left, right, bottom, top (tick labels, title).
+MARGINS = (0.7, 0.25, 0.45, 0.4)
 #: Each pixel of a PNG is painted from SUPERSAMPLE × SUPERSAMPLE samples (smooth lines).
 SUPERSAMPLE = 3
 
@@ -46,6 +55,13 @@ INK = "#000000"
 MARK = "#ff0000"
 FONT_SIZE = 10.0
 TITLE_SIZE = 12.0
+
+
+def fibre_arrow_length(coordinates: np.ndarray) -> float:
+    """The length of the warp and fill arrows drawn on a pattern ``(n, 2)``: 15 % of its longer
+    side, and inside its box however narrow it is (a strip of roll width)."""
+    extent = np.ptp(np.asarray(coordinates, dtype=float), axis=0)
+    return min(0.15 * float(extent.max()), 0.35 * float(extent.min()))
 
 
 def nice_ticks(low: float, high: float, most: int = 8) -> np.ndarray:
@@ -77,6 +93,39 @@ def _tick_label(value: float, step: float) -> str:
     return text.replace("-", "\u2212")
 
 
+class _Cells(NamedTuple):
+    """Cells filled: their outline ``loops`` (for SVG, the non-zero rule), the ``cells`` at
+    placed ``points`` (for PNG, rasterised), in ``colour``."""
+
+    loops: list[np.ndarray]
+    cells: Mapping[str, np.ndarray]
+    points: np.ndarray
+    colour: str
+
+
+class _Lines(NamedTuple):
+    """Line segments ``(k, 2, 2)``, or closed polylines (``closed``: a list of ``(m, 2)``)."""
+
+    lines: np.ndarray | list[np.ndarray]
+    colour: str
+    width: float
+    closed: bool
+
+
+class _Arrow(NamedTuple):
+    start: np.ndarray
+    end: np.ndarray
+    label: str
+    dashed: bool
+    width: float
+
+
+class _Rings(NamedTuple):
+    points: np.ndarray
+    colour: str
+    diameter: float
+
+
 @dataclass
 class Sketch:
     """A drawing of a pattern in its own coordinates: the axes' data ``limits`` (x0, x1, y0,
@@ -86,13 +135,13 @@ class Sketch:
     limits: tuple[float, float, float, float]
     size: tuple[float, float]
     title: str | None = None
-    _items: list[tuple] = field(default_factory=list)
+    _items: list[NamedTuple] = field(default_factory=list)
 
     # -- placing -------------------------------------------------------------------------
     @property
     def axes(self) -> tuple[float, float, float, float]:
         """The axes box in points: left, top, width, height (y down)."""
-        left, right, bottom, top = MARGINS
+        left, right, bottom, top = (POINT * m for m in MARGINS)
         width, height = self.size
         return left, top, width - left - right, height - top - bottom
 
@@ -107,27 +156,28 @@ class Sketch:
         )
 
     # -- primitives (drawing coordinates) ------------------------------------------------
-    def fill(self, loops: Sequence[np.ndarray], colour: str, holes: bool = True) -> None:
-        """The region inside closed ``loops`` (each ``(k, 2)``): where ``holes``, those wound
-        against the largest one are holes (the non-zero rule), else each is filled."""
-        self._items.append(("fill", [self.place(loop) for loop in loops], colour, holes))
+    def cells(self, mesh: SurfaceMesh, coordinates: np.ndarray, colour: str) -> None:
+        """The cells of ``mesh`` at ``coordinates`` ``(n, 2)`` filled: where the pattern laps
+        over itself too, and its holes left empty."""
+        loops = [self.place(coordinates[loop]) for loop in mesh.boundary_loops()]
+        self._items.append(_Cells(loops, mesh.cells, self.place(coordinates), colour))
 
     def segments(self, segments: np.ndarray, colour: str, width: float) -> None:
         """Line segments ``(k, 2, 2)``, ``width`` points wide."""
-        self._items.append(("segments", self.place(segments), colour, width))
+        self._items.append(_Lines(self.place(segments), colour, width, closed=False))
 
-    def loops(self, loops: Sequence[np.ndarray], colour: str, width: float) -> None:
-        """Closed polylines."""
-        self._items.append(("loops", [self.place(loop) for loop in loops], colour, width))
+    def loops(self, loops: list[np.ndarray], colour: str, width: float) -> None:
+        """Closed polylines (each ``(m, 2)``)."""
+        self._items.append(_Lines([self.place(loop) for loop in loops], colour, width, True))
 
     def arrow(self, start, end, label: str, dashed: bool = False, width: float = 1.4) -> None:
         """An arrow from ``start`` to ``end`` with ``label`` just beyond its head."""
         a, b = self.place(np.asarray([start, end], dtype=float))
-        self._items.append(("arrow", a, b, label, dashed, width))
+        self._items.append(_Arrow(a, b, label, dashed, width))
 
     def rings(self, points: np.ndarray, colour: str, diameter: float = 9.0) -> None:
         """Circles of ``diameter`` points around ``points`` ``(k, 2)``."""
-        self._items.append(("rings", self.place(np.reshape(points, (-1, 2))), colour, diameter))
+        self._items.append(_Rings(self.place(np.reshape(points, (-1, 2))), colour, diameter))
 
     # -- the axes ------------------------------------------------------------------------
     def _ticks(self) -> list[tuple[str, float, str]]:
@@ -148,15 +198,17 @@ class Sketch:
                 )
         return ticks
 
-    def _arrow_parts(self, a: np.ndarray, b: np.ndarray, width: float, label: str):
+    @staticmethod
+    def _arrow_parts(arrow: _Arrow):
         """The shaft's end (short of the tip), the head's triangle and the label's centre,
         clear of the tip (text about 0.55 em wide per letter)."""
+        a, b, width = arrow.start, arrow.end, arrow.width
         direction = (b - a) / max(float(np.linalg.norm(b - a)), 1e-12)
         normal = np.array([-direction[1], direction[0]])
         length, half = 4.5 * width, 2.2 * width
         base = b - length * direction
         head = np.array([b, base + half * normal, base - half * normal])
-        half_text = np.array([0.28 * FONT_SIZE * len(label), 0.5 * FONT_SIZE])
+        half_text = np.array([0.28 * FONT_SIZE * len(arrow.label), 0.5 * FONT_SIZE])
         clearance = float(np.abs(direction) @ half_text) + 3.0
         return base, head, b + clearance * direction
 
@@ -171,47 +223,33 @@ class Sketch:
             f'height="{height:.2f}pt" viewBox="0 0 {width:.2f} {height:.2f}" '
             'font-family="DejaVu Sans, Arial, Helvetica, sans-serif">',
             f'<rect width="{width:.2f}" height="{height:.2f}" fill="#ffffff"/>',
-            "<g>",
         ]
-        texts = []
+        arrows = []
         for item in self._items:
-            kind = item[0]
-            if kind == "fill" and item[3]:
-                path = " ".join(_svg_loop(loop) for loop in item[1])
-                out.append(f'<path d="{path}" fill="{item[2]}" fill-rule="nonzero" stroke="none"/>')
-            elif kind == "fill":
-                out += [f'<path d="{_svg_loop(loop)}" fill="{item[2]}"/>' for loop in item[1]]
-            elif kind == "segments":
-                path = "".join(
-                    f"M{p[0, 0]:.2f} {p[0, 1]:.2f}L{p[1, 0]:.2f} {p[1, 1]:.2f}" for p in item[1]
-                )
+            if isinstance(item, _Cells):
+                path = " ".join(_svg_loop(loop) for loop in item.loops)
                 out.append(
-                    f'<path d="{path}" fill="none" stroke="{item[2]}" stroke-width="{item[3]}"/>'
+                    f'<path d="{path}" fill="{item.colour}" fill-rule="nonzero" stroke="none"/>'
                 )
-            elif kind == "loops":
-                path = " ".join(_svg_loop(loop) for loop in item[1])
+            elif isinstance(item, _Lines):
+                if item.closed:
+                    path = " ".join(_svg_loop(loop) for loop in item.lines)
+                else:
+                    path = "".join(
+                        f"M{a[0]:.2f} {a[1]:.2f}L{b[0]:.2f} {b[1]:.2f}" for a, b in item.lines
+                    )
                 out.append(
-                    f'<path d="{path}" fill="none" stroke="{item[2]}" stroke-width="{item[3]}" '
-                    'stroke-linejoin="round"/>'
+                    f'<path d="{path}" fill="none" stroke="{item.colour}" '
+                    f'stroke-width="{item.width}" stroke-linejoin="round"/>'
                 )
-            elif kind == "rings":
-                _, points, colour, diameter = item
+            elif isinstance(item, _Rings):
                 out += [
-                    f'<circle cx="{x:.2f}" cy="{y:.2f}" r="{diameter / 2:.2f}" fill="none" '
-                    f'stroke="{colour}" stroke-width="1.5"/>'
-                    for x, y in points
+                    f'<circle cx="{x:.2f}" cy="{y:.2f}" r="{item.diameter / 2:.2f}" '
+                    f'fill="none" stroke="{item.colour}" stroke-width="1.5"/>'
+                    for x, y in item.points
                 ]
-            elif kind == "arrow":
-                _, a, b, label, dashed, lw = item
-                base, head, at = self._arrow_parts(a, b, lw, label)
-                dash = f' stroke-dasharray="{3.7 * lw:.2f} {1.6 * lw:.2f}"' if dashed else ""
-                texts += [
-                    f'<line x1="{a[0]:.2f}" y1="{a[1]:.2f}" x2="{base[0]:.2f}" '
-                    f'y2="{base[1]:.2f}" stroke="{INK}" stroke-width="{lw}"{dash}/>',
-                    f'<path d="{_svg_loop(head)}" fill="{INK}"/>',
-                    _svg_text(at, label, FONT_SIZE, "middle", "central"),
-                ]
-        out.append("</g>")
+            else:
+                arrows.append(item)
         out.append(
             f'<rect x="{left:.2f}" y="{top:.2f}" width="{w:.2f}" height="{h:.2f}" '
             f'fill="none" stroke="{INK}" stroke-width="0.8"/>'
@@ -230,7 +268,16 @@ class Sketch:
                     f'y2="{position:.2f}" stroke="{INK}" stroke-width="0.8"/>'
                 )
                 out.append(_svg_text((left - 5, position), label, FONT_SIZE, "end", "central"))
-        out += texts
+        for arrow in arrows:
+            a, lw = arrow.start, arrow.width
+            base, head, at = self._arrow_parts(arrow)
+            dash = f' stroke-dasharray="{3.7 * lw:.2f} {1.6 * lw:.2f}"' if arrow.dashed else ""
+            out += [
+                f'<line x1="{a[0]:.2f}" y1="{a[1]:.2f}" x2="{base[0]:.2f}" '
+                f'y2="{base[1]:.2f}" stroke="{INK}" stroke-width="{lw}"{dash}/>',
+                f'<path d="{_svg_loop(head)}" fill="{INK}"/>',
+                _svg_text(at, arrow.label, FONT_SIZE, "middle", "central"),
+            ]
         if self.title:
             out.append(_svg_text((left + w / 2, top - 6), self.title, TITLE_SIZE, "middle", "auto"))
         out.append("</svg>")
@@ -238,8 +285,12 @@ class Sketch:
 
     # -- PNG -----------------------------------------------------------------------------
     def png(self, dpi: float = DPI, compress_level: int = 4) -> bytes:
-        """The sketch painted at ``dpi`` as PNG bytes (Pillow)."""
+        """The sketch painted at ``dpi`` as PNG bytes (Pillow); cells are rasterised at the
+        picture's own pixels (:func:`vares.io.raster.rasterise`), lines at 3 × 3 samples a
+        pixel."""
         from PIL import Image, ImageDraw
+
+        from .raster import rasterise
 
         k = dpi / POINT * SUPERSAMPLE  # samples per point
         width, height = self.size
@@ -258,54 +309,48 @@ class Sketch:
         title_font, _ = _font(TITLE_SIZE * k)
         arrows = []
         for item in self._items:
-            kind = item[0]
-            if kind == "fill":
-                _, loops, colour, holes = item
-                areas = [_signed_area(loop) for loop in loops]
-                outer = max(areas, key=abs) if holes else 0.0
-                for loop, area in zip(
-                    loops, areas, strict=True
-                ):  # the outer loops, then holes cut out
-                    if not holes or area * outer > 0:
-                        draw.polygon(px(loop), fill=colour)
-                for loop, area in zip(loops, areas, strict=True):
-                    if holes and area * outer <= 0:
-                        draw.polygon(px(loop), fill="#ffffff")
-            elif kind == "segments":
-                lw = stroke(item[3])
-                for a, b in item[1] * k:
-                    draw.line([tuple(a), tuple(b)], fill=item[2], width=lw)
-            elif kind == "loops":
-                lw = stroke(item[3])
-                for loop in item[1]:
-                    points = px(loop)
-                    draw.line(points + points[:1], fill=item[2], width=lw, joint="curve")
-            elif kind == "rings":
-                _, points, colour, diameter = item
-                r = diameter / 2 * k
-                for x, y in points * k:
-                    draw.ellipse([x - r, y - r, x + r, y + r], outline=colour, width=stroke(1.5))
-            elif kind == "arrow":
+            if isinstance(item, _Cells):  # pixel rows downwards, as the picture's
+                grid = (0.0, 0.0, 1.0, pixels[0], pixels[1])
+                covered = rasterise(item.cells, item.points * dpi / POINT, grid=grid).index >= 0
+                mask = Image.fromarray(covered.astype(np.uint8) * 255)
+                image.paste(item.colour, mask=mask.resize(image.size, Image.Resampling.NEAREST))
+            elif isinstance(item, _Lines):
+                lw = stroke(item.width)
+                if item.closed:
+                    for loop in item.lines:
+                        points = px(loop)
+                        draw.line(points + points[:1], fill=item.colour, width=lw, joint="curve")
+                else:
+                    for a, b in item.lines * k:
+                        draw.line([tuple(a), tuple(b)], fill=item.colour, width=lw)
+            elif isinstance(item, _Rings):
+                r = item.diameter / 2 * k
+                for x, y in item.points * k:
+                    draw.ellipse(
+                        [x - r, y - r, x + r, y + r], outline=item.colour, width=stroke(1.5)
+                    )
+            else:
                 arrows.append(item)
         lw = stroke(0.8)
         draw.rectangle([left * k, top * k, (left + w) * k, (top + h) * k], outline=INK, width=lw)
         for axis, position, label in self._ticks():
+            label = label.replace("\u2212", minus)
             if axis == "x":
                 y = (top + h) * k
                 draw.line([(position * k, y), (position * k, y + 3.5 * k)], fill=INK, width=lw)
-                label = label.replace("\u2212", minus)
                 draw.text((position * k, y + 5 * k), label, fill=INK, font=font, anchor="mt")
             else:
                 x = left * k
                 draw.line([(x - 3.5 * k, position * k), (x, position * k)], fill=INK, width=lw)
-                label = label.replace("\u2212", minus)
                 draw.text((x - 5 * k, position * k), label, fill=INK, font=font, anchor="rm")
-        for _, a, b, label, dashed, width_ in arrows:
-            base, head, at = self._arrow_parts(a, b, width_, label)
-            for piece in _dashes(a, base, 3.7 * width_, 1.6 * width_) if dashed else [(a, base)]:
-                draw.line(px(np.array(piece)), fill=INK, width=stroke(width_))
+        for arrow in arrows:
+            a, aw = arrow.start, arrow.width
+            base, head, at = self._arrow_parts(arrow)
+            pieces = _dashes(a, base, 3.7 * aw, 1.6 * aw) if arrow.dashed else [(a, base)]
+            for piece in pieces:
+                draw.line(px(np.array(piece)), fill=INK, width=stroke(aw))
             draw.polygon(px(head), fill=INK)
-            draw.text(tuple(at * k), label, fill=INK, font=font, anchor="mm")
+            draw.text(tuple(at * k), arrow.label, fill=INK, font=font, anchor="mm")
         if self.title:
             draw.text(
                 ((left + w / 2) * k, (top - 6) * k), self.title, fill=INK, font=title_font,
@@ -347,11 +392,6 @@ def _svg_text(at, text: str, size: float, anchor: str, baseline: str) -> str:
     )
 
 
-def _signed_area(loop: np.ndarray) -> float:
-    x, y = loop[:, 0], loop[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
-
-
 def _dashes(a: np.ndarray, b: np.ndarray, on: float, off: float) -> list[tuple]:
     """The dashes of a dashed line from ``a`` to ``b``."""
     length = float(np.linalg.norm(b - a))
@@ -371,12 +411,12 @@ def _frame(coordinates: np.ndarray) -> tuple[tuple[float, float, float, float], 
     low, high = low - 0.03 * longest, high + 0.03 * longest
     span = high - low
     aspect = float(np.clip(span[1] / span[0], 0.15, 4.0))  # axes height / width
-    left, right, bottom, top = MARGINS
+    left, right, bottom, top = (POINT * m for m in MARGINS)
     if aspect <= 1:
-        w = SIDE - left - right
+        w = POINT * SIDE - left - right
         h = w * aspect
     else:
-        h = SIDE - bottom - top
+        h = POINT * SIDE - bottom - top
         w = h / aspect
     scale = min(w / span[0], h / span[1])  # equal axes: the pattern fits, centred
     centre = 0.5 * (low + high)
@@ -394,31 +434,20 @@ def pattern_sketch(
     marks: np.ndarray | None = None,
 ) -> Sketch:
     """A pattern ``(n, 2)`` as :func:`vares.io.plot.plot_pattern` draws it without a field:
-    filled, with its mesh lines (up to :data:`MESH_LINES_UP_TO` cells), its
-    outline, warp (solid) and fill (dashed) arrows and ``marks`` ``(k, 2)`` circled in red."""
+    filled, with its mesh lines (up to :data:`MESH_LINES_UP_TO` cells), its outline, warp
+    (solid) and fill (dashed) arrows and ``marks`` ``(k, 2)`` circled in red."""
     coordinates = np.asarray(coordinates, dtype=float)
     limits, size = _frame(coordinates)
     sketch = Sketch(limits, size, title)
-    try:
-        loops = [coordinates[loop] for loop in mesh.boundary_loops()]
-    except MeshError:  # an outline through a node twice: every cell filled on its own
-        loops = None
-    if loops is not None:
-        sketch.fill(loops, FACE)
-    else:
-        sketch.fill([coordinates[c] for block in mesh.cells.values() for c in block], FACE, False)
+    sketch.cells(mesh, coordinates, FACE)
     if mesh.num_cells <= MESH_LINES_UP_TO:
         sketch.segments(coordinates[mesh.edges()], MESH, 0.2)
-    if loops is not None:
-        sketch.loops(loops, INK, 0.6)
-    else:
-        sketch.segments(coordinates[mesh.boundary_edges()], INK, 0.6)
+    sketch.loops([coordinates[loop] for loop in mesh.boundary_loops()], INK, 0.6)
     if marks is not None and len(marks):
         sketch.rings(np.asarray(marks, dtype=float), MARK)
     if fibres is not None:
         centre = coordinates.mean(axis=0)
-        extent = np.ptp(coordinates, axis=0)  # arrows inside the pattern's box, as long a strip's
-        length = min(0.15 * float(extent.max()), 0.35 * float(extent.min()))
+        length = fibre_arrow_length(coordinates)
         sketch.arrow(centre, centre + length * np.asarray(fibres.warp), "warp")
         sketch.arrow(centre, centre + length * np.asarray(fibres.fill), "fill", dashed=True)
     return sketch

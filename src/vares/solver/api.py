@@ -124,7 +124,8 @@ def _solve(mesh, material, thickness, prestress, options, callback, given) -> Pa
         # a start that is not one-to-one can lead to a minimum whose outline laps over itself;
         # Tutte's embedding starts on the right side of every fold (not for pseudo-time, whose
         # steps start from a projection)
-        retry = run.attempt(Start(tutte(mesh), "tutte", None), restart=True)
+        conformal = start.coordinates if start.kind == "lscm" else None  # its boundary's shape
+        retry = run.attempt(Start(tutte(mesh, conformal), "tutte", None), restart=True)
         if retry.reason is None or retry.energy < attempt.energy:
             attempt = retry
     return PatternResult(

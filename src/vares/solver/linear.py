@@ -101,9 +101,11 @@ class SuperLUSolver:
         self._lu = None
         self._matrix = None
         self._pivoted_on_diagonal = False
+        self._checked = False  # the diagonal pivots' accuracy, checked on the first solve
 
     def factorize(self, matrix: sp.csr_matrix, definite: bool = False) -> None:
         self._matrix = matrix
+        self._checked = False
         self._lu = None  # the last factors freed before the next are made: at 1M triangles
         # the two together were the peak (4.7 GiB instead of 3.4 GiB)
         try:
@@ -129,7 +131,10 @@ class SuperLUSolver:
         if self._lu is None:
             raise RuntimeError("factorize() must be called before solve()")
         x = self._lu.solve(rhs)
-        if self._pivoted_on_diagonal:
+        if self._pivoted_on_diagonal and not self._checked:
+            # small pivots spoil every solve with these factors alike: checking the first is
+            # enough (CG with these factors as preconditioner solves with them many times)
+            self._checked = True
             residual = np.linalg.norm(self._matrix @ x - rhs)
             if not residual <= DIAGONAL_PIVOTING_RESIDUAL * np.linalg.norm(rhs):
                 self._partial_pivoting()

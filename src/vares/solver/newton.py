@@ -209,7 +209,6 @@ def newton(
     step_lengths: list[float] = []
     evaluation = None  # the line search's evaluation of the point it accepted, if it has one
     squeezed = 0  # iterations in a row whose steps a fold held back, each shorter
-    norms: list[float] = []  # the residual norms of this iteration
     for iteration in range(ctx.max_iterations + 1):
         if evaluation is None:
             try:
@@ -254,8 +253,9 @@ def newton(
             return x
         if iteration == ctx.max_iterations:
             raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
-        norms.append(residual)
-        eta = forcing_term(norms, ctx.residual_tolerance, ctx.loosest_forcing)
+        eta = forcing_term(
+            residuals, ctx.residual_tolerance / ctx.force_scale, ctx.loosest_forcing
+        )  # relative residuals: the same ratios
         if method == "full":
             x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector, eta)
             evaluation = None
@@ -350,7 +350,7 @@ class _Path:
 
     def __init__(self, x: np.ndarray, direction: np.ndarray, pivot: int | None) -> None:
         self.x, self.rest, self.turn = x, direction, 0.0
-        if pivot is None:  # a pattern's (2D) steps only turn
+        if pivot is None:  # no turn: a straight step
             return
         self.centre = x[pivot]
         self.arm = x - self.centre

@@ -8,8 +8,6 @@ import typer
 
 from ...analysis.options import ErectionOptions
 from ..job import load_job
-from ..outputs import JOB_FILE
-from ..runner import run_erection
 from .common import console, fail, guarded, progress, show_erection
 from .flags import InputError, build, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
@@ -55,6 +53,9 @@ def erect(
             )
         if not directory.is_dir():
             raise InputError(f"no such directory: {directory}")
+        from ..outputs import JOB_FILE  # the engine, when the command runs (common.py)
+        from ..runner import run_erection
+
         job_file = directory / JOB_FILE
         saved = load_job(job_file).erection if job_file.is_file() else None
         given = {k: v for k, v in values.items() if k in ErectionOptions.specs() and v is not None}
