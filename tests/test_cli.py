@@ -114,6 +114,31 @@ def test_failed_solve_exits_1_with_the_reason_and_writes_no_pattern(tmp_path):
     assert summary["converged"] is False and summary["reason"].startswith("inverted")
 
 
+def test_an_absurd_mark_spacing_is_refused_before_the_solve(tmp_path):
+    mesh = hypar(size=4.0, rise=0.15, n=8)
+    source = tmp_path / "hypar.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    (loop,) = mesh.boundary_loops()
+    ring = mesh.points[np.append(loop, loop[0])]
+    boundary = np.linalg.norm(np.diff(ring, axis=0), axis=1).sum()  # metres
+    out = tmp_path / "out"
+    for command in ("pattern", "cut"):
+        extra = ("--roll-width", 1.5) if command == "cut" else ()
+        result = run(command, source, "-o", out, "--mark-spacing", 1e-9, *extra)
+        assert result.exit_code == 2, result.stderr
+        line = error_line(result)
+        assert "--mark-spacing" in line and f"{boundary:.3g} m of the surface's boundary" in line
+        assert f"at least {boundary * 1000 / 100_000:.3g} mm" in line
+        assert "step" not in result.stderr and not out.exists()  # before the solve
+    # a spacing that leaves fewer marks than the bound is drawn
+    result = run("pattern", source, "-o", out, "--mark-spacing", 500, "-q")
+    assert result.exit_code == 0, result.stderr
+    import ezdxf
+
+    marks = ezdxf.readfile(out / "pattern.dxf").modelspace().query("LINE[layer=='MARKS']")
+    assert len(marks) == pytest.approx(boundary / 0.5, abs=1)
+
+
 def test_plane_normal_option(tmp_path):
     mesh = cylinder160(n_around=12, n_along=3)
     source = tmp_path / "c.vtu"

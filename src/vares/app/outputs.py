@@ -40,13 +40,16 @@ from ..io.sketch import DPI, pattern_sketch
 from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
+from ..units import unit_factor
 from .erection_outputs import erection_files
 from .inputs import Input, safe_name
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
+from .sections import MAX_MARKS
 
 __all__ = [
     "JOB_FILE",
+    "check_mark_spacing",
     "panel_directory",
     "planned_files",
     "safe_name",
@@ -109,6 +112,31 @@ def planned_files(job: Job, source: Input, save_job: Path | None = None) -> list
     if save_job is not None and job.directory.resolve() in save_job.resolve().parents:
         files.append(save_job)
     return files
+
+
+def check_mark_spacing(job: Job, source: Input) -> None:
+    """Refuse a match mark spacing that would put more than :data:`MAX_MARKS` marks along the
+    boundaries of the job's surfaces (a pattern's outline is as long as its surface's boundary,
+    within the strain); a :class:`JobError` gives the shortest admissible spacing."""
+    spacing = job.output.mark_spacing
+    if spacing is None:
+        return
+    length = 0.0
+    for panel in source.panels:
+        points = panel.mesh.points
+        for loop in panel.mesh.boundary_loops():
+            ring = points[np.append(loop, loop[0])]
+            length += float(np.linalg.norm(np.diff(ring, axis=0), axis=1).sum())
+    units = job.output.dxf_units
+    where = "surface's boundary" if len(source.panels) == 1 else "panels' boundaries"
+    count = length * unit_factor(source.units, units) / spacing
+    if count > MAX_MARKS:
+        shortest = spacing * count / MAX_MARKS
+        raise JobError(
+            f"the match mark spacing (--mark-spacing) {spacing:g} {units} would put {count:.2g} "
+            f"marks along the {length:.3g} {source.units} of the {where} (at most "
+            f"{MAX_MARKS}): give a spacing of at least {shortest:.3g} {units}"
+        )
 
 
 def write_job_file(job: Job, directory: Path) -> Path:

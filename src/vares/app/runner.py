@@ -32,6 +32,7 @@ from .job import Job, JobError, load_job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import (
     JOB_FILE,
+    check_mark_spacing,
     panel_directory,
     planned_files,
     structure_marks,
@@ -61,6 +62,7 @@ def run_job(
     """
     material = job.material.build(job.base)
     source = load_input(job)
+    check_mark_spacing(job, source)
     folder = OutputFolder(
         job.directory,
         planned_files(job, source, save_job),

@@ -235,6 +235,11 @@ class PrestressOptions(Options):
 #: Match mark spacing of a structure's seams when none is given (DXF units).
 STRUCTURE_MARK_SPACING = 500.0
 
+#: The most match marks a run draws along its surfaces' boundaries: a spacing that would draw
+#: more is a slip of a digit or of units (marks closer than a pencil line), refused before the
+#: solve (``vares.app.outputs.check_mark_spacing``).
+MAX_MARKS = 100_000
+
 
 @dataclass(frozen=True)
 class OutputOptions(Options):
@@ -262,7 +267,8 @@ class OutputOptions(Options):
         None,
         "float",
         "Match mark spacing along the seam line (DXF units); a structure's seams get marks every "
-        f"{STRUCTURE_MARK_SPACING:g} unless given.",
+        f"{STRUCTURE_MARK_SPACING:g} unless given. At most {MAX_MARKS} marks fit along the "
+        "surface's boundary.",
         section="output",
         positive=True,
     )
