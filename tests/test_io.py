@@ -442,6 +442,43 @@ def test_job_files_run_save_and_report_bad_keys(tmp_path):
         load_job(job)
 
 
+def test_a_job_file_reads_back_whatever_its_names_and_paths_hold(tmp_path):
+    from vares.app.job import Job
+
+    odd = 'roof "north"\\ C:\\tmp\tpanel\nline two\r\x01\x7f ü Ω 屋根 🎪'
+    job = Job.from_dict(
+        {
+            "input": {"mesh": f"{odd}.obj", "name": odd, "panel_field": odd},
+            "prestress": {"field": [odd, "fill"]},
+            "output": {"directory": odd},
+        },
+        base=tmp_path,
+    )
+    text = job.to_toml(tmp_path / "job.toml")
+    (tmp_path / "job.toml").write_text(text, encoding="utf-8")
+    again = load_job(tmp_path / "job.toml")
+    assert again.input.name == odd and again.input.panel_field == odd
+    assert again.prestress.field == (odd, "fill")
+    assert again.path(again.input.mesh) == tmp_path / f"{odd}.obj"
+    assert again.directory == tmp_path / odd
+    assert again.to_dict() == job.to_dict()
+    # the job a run writes into its folder runs again, from a file whose name has a newline
+    mesh = vares.examples.hypar(size=4.0, rise=0.2, n=6)
+    source = tmp_path / 'new\nline "quoted"\ttab.ply'
+    meshio.write(source, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    result = run("pattern", source, "-o", tmp_path / "first", "-q")
+    assert result.exit_code == 0, result.stderr
+    result = run("run", tmp_path / "first" / "job.toml", "-o", tmp_path / "second", "-q")
+    assert result.exit_code == 0, result.stderr
+    written = load_job(tmp_path / "first" / "job.toml")
+    assert written.path(written.input.mesh).resolve() == source.resolve()
+    np.testing.assert_allclose(
+        meshio.read(tmp_path / "second" / "pattern.obj").points,
+        meshio.read(tmp_path / "first" / "pattern.obj").points,
+        atol=1e-12,
+    )
+
+
 @pytest.mark.parametrize(
     ("name", "content"),
     [

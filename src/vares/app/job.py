@@ -230,11 +230,39 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, int | float):
         return repr(float(value)) if isinstance(value, float) else str(value)
     if isinstance(value, str | Path):
-        text = str(value).replace("\\", "\\\\").replace('"', '\\"')
-        return f'"{text}"'
+        return _toml_string(str(value))
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_toml_value(v) for v in value) + "]"
     raise JobError(f"cannot write {value!r} to a job file")
+
+
+#: The escapes of a TOML basic string; other control characters are written as ``\uXXXX``.
+_TOML_ESCAPES = {
+    "\\": "\\\\",
+    '"': '\\"',
+    "\b": "\\b",
+    "\t": "\\t",
+    "\n": "\\n",
+    "\f": "\\f",
+    "\r": "\\r",
+}
+
+
+def _toml_string(text: str) -> str:
+    """``text`` as a TOML basic string: quoted, with every character TOML does not admit there
+    (quote, backslash, control characters) escaped, so any name or path reads back as it was."""
+    out = []
+    for character in text:
+        code = ord(character)
+        if character in _TOML_ESCAPES:
+            out.append(_TOML_ESCAPES[character])
+        elif code < 0x20 or code == 0x7F:
+            out.append(f"\\u{code:04X}")
+        elif 0xD800 <= code <= 0xDFFF:
+            raise JobError(f"cannot write {text!r} to a job file: it is not valid Unicode")
+        else:
+            out.append(character)
+    return '"' + "".join(out) + '"'
 
 
 def load_job(path: str | Path) -> Job:
