@@ -1,6 +1,7 @@
 """Real inputs: readers for ordinary files, repair said aloud, units, coarse precision."""
 
 import json
+import re
 
 import meshio
 import numpy as np
@@ -9,6 +10,7 @@ from conftest import error_line, run
 
 import vares
 from vares.geometry.examples import hypar
+from vares.geometry.mesh import MeshError
 from vares.geometry.repair import repair
 from vares.io.meshes import read_mesh_file
 from vares.io.rhino import NamedMesh, write_3dm
@@ -37,6 +39,44 @@ def test_obj_with_texture_normal_and_relative_indices(tmp_path):
     read = vares.read_mesh(path)
     np.testing.assert_array_equal(read.points, mesh.points)
     np.testing.assert_array_equal(read.cells["triangle"], mesh.cells["triangle"])
+
+
+@pytest.mark.parametrize(
+    ("tail", "message"),
+    [
+        ("f \n", "ends in an incomplete face at line {line} ('f')"),
+        ("f", "ends in an incomplete face at line {line} ('f')"),
+        ("f 1 2\n\n", "ends in an incomplete face at line {line} ('f 1 2')"),
+        ("f 1 2\nf 1 2 3\n", "line {line}: a face needs three vertices or more"),
+    ],
+)
+def test_an_obj_with_an_incomplete_face_names_its_line(tmp_path, tail, message):
+    mesh = hypar(n=4)
+    lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in mesh.points]
+    lines += [f"f {a} {b} {c}" for a, b, c in mesh.cells["triangle"] + 1]
+    path = tmp_path / "cut_short.obj"
+    path.write_text("\n".join(lines) + "\n" + tail)
+    expected = message.format(line=len(lines) + 1)
+    with pytest.raises(MeshError, match=re.escape(expected)):
+        read_mesh_file(path)
+    result = run("pattern", path, "-o", tmp_path / "out")
+    assert result.exit_code == 2 and expected in error_line(result)
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_obj_of_faces_of_several_sizes_is_read_face_by_face(tmp_path):
+    # quads first and last, a triangle and a pentagon between: as many indices as four quads
+    path = tmp_path / "mixed.obj"
+    points = [(0, 0), (1, 0), (2, 0), (3, 0), (0, 1), (1, 1), (2, 1), (3, 1), (1.5, 0), (1.5, 1)]
+    faces = ["1 2 6 5", "2 9 6", "9 3 7 10 6", "3 4 8 7"]
+    path.write_text(
+        "".join(f"v {x} {y} 0\n" for x, y in points) + "".join(f"f {f}\n" for f in faces)
+    )
+    mesh_file = read_mesh_file(path)
+    assert mesh_file.repair.triangulated_polygons == 1
+    surface = mesh_file.surface()
+    assert len(surface.cells["quad"]) == 2 and len(surface.cells["triangle"]) == 1 + 3
+    assert surface.cell_areas().sum() == pytest.approx(3.0, rel=1e-12)
 
 
 def test_off_and_ply_with_quads_and_polygons(tmp_path):

@@ -9,6 +9,7 @@ in the order the faces appear in the file block by block (triangles, quads, poly
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -79,7 +80,9 @@ def read_obj(path: Path) -> PolygonSoup:
         return fast
     points: list[list[float]] = []
     faces: list[list[int]] = []
-    for number, line in enumerate(text.splitlines(), start=1):
+    lines = text.splitlines()
+    last = max((n for n, line in enumerate(lines, start=1) if line.strip()), default=0)
+    for number, line in enumerate(lines, start=1):
         tokens = line.split()
         if not tokens:
             continue
@@ -89,15 +92,31 @@ def read_obj(path: Path) -> PolygonSoup:
                 raise MeshError(f"{path}, line {number}: a vertex needs x, y and z")
             points.append(values)
         elif tokens[0] == "f":
+            if len(tokens) < 4:
+                if number == last:
+                    raise MeshError(
+                        f"{path} ends in an incomplete face at line {number} "
+                        f"({line.strip()!r}): the file was cut short"
+                    )
+                raise MeshError(
+                    f"{path}, line {number}: a face needs three vertices or more; "
+                    f"got {line.strip()!r}"
+                )
             indices = _numbers([t.split("/")[0] for t in tokens[1:]], path, number, int)
             # 1-based; negative counts back from the vertices read so far
             faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
     return _soup(points, faces, path)
 
 
+#: Vertex or face lines the fast reader does not take: a keyword followed by a tab, or alone.
+_UNUSUAL_OBJ_LINE = re.compile(r"^[vf](\t|[ \t]*\r?$)", re.MULTILINE)
+
+
 def _plain_obj(text: str) -> PolygonSoup | None:
     """The common case read at numpy speed: ``v x y z`` lines and triangle or quad faces of
     positive plain indices only; ``None`` for anything else (read line by line instead)."""
+    if _UNUSUAL_OBJ_LINE.search(text):
+        return None
     lines = text.split("\n")
     vertices = [line[2:] for line in lines if line.startswith("v ")]
     faces = [line[2:] for line in lines if line.startswith("f ")]
@@ -108,12 +127,8 @@ def _plain_obj(text: str) -> PolygonSoup | None:
         indices = np.array(" ".join(faces).split(), dtype=np.int64)
     except ValueError:
         return None
-    sizes = {len(faces[0].split()), len(faces[-1].split())}
-    if (
-        points.size != 3 * len(vertices)
-        or len(sizes) != 1
-        or indices.size != len(faces) * min(sizes)
-    ):
+    sizes = {len(face.split()) for face in faces}
+    if points.size != 3 * len(vertices) or len(sizes) != 1:
         return None
     nen = sizes.pop()
     if nen not in (3, 4) or indices.min() < 1 or indices.max() > len(vertices):
