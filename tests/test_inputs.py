@@ -79,6 +79,39 @@ def test_an_obj_of_faces_of_several_sizes_is_read_face_by_face(tmp_path):
     assert surface.cell_areas().sum() == pytest.approx(3.0, rel=1e-12)
 
 
+def test_a_file_named_stl_must_be_an_stl(tmp_path):
+    mesh = hypar(n=4)
+    surface = meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])])
+    meshio.write(tmp_path / "ascii.stl", surface, binary=False)
+    meshio.write(tmp_path / "binary.stl", surface, binary=True)
+    binary = (tmp_path / "binary.stl").read_bytes()
+    # some exporters begin a binary STL's header with "solid", as an ASCII one begins
+    (tmp_path / "solid.stl").write_bytes(b"solid part".ljust(80) + binary[80:])
+    for name in ("ascii.stl", "binary.stl", "solid.stl"):
+        read = vares.read_mesh(tmp_path / name)
+        assert read.num_cells == mesh.num_cells and read.num_points == mesh.num_points, name
+    n = mesh.num_cells
+    obj = ["# roof"] + [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in mesh.points]
+    obj += ["vn 0 0 1"] * 3 + [f"f {a} {b} {c}" for a, b, c in mesh.cells["triangle"] + 1]
+    ascii_lines = (tmp_path / "ascii.stl").read_text().splitlines()
+    ascii_lines[3] = ascii_lines[3].replace("vertex", "v")
+    bad = {
+        # meshio reads it as ASCII STL: the last three numbers of each line, scattered triangles
+        "obj.stl": ("\n".join(obj).encode(), f"an OBJ file ({mesh.num_points} 'v' and {n} 'f'"),
+        "short.stl": (binary[:-7], f"84 + 50·{n} = {84 + 50 * n} bytes, this file has "),
+        "text.stl": (b"mesh\n1 2 3\n4 5 6\n", "an ASCII STL begins with 'solid'"),
+        "stray.stl": ("\n".join(ascii_lines).encode(), "line 4: 'v "),
+    }
+    for name, (content, message) in bad.items():
+        (tmp_path / name).write_bytes(content)
+        with pytest.raises(MeshError, match=re.escape(message)):
+            read_mesh_file(tmp_path / name)
+    result = run("pattern", tmp_path / "obj.stl", "-o", tmp_path / "out")
+    assert result.exit_code == 2
+    assert "obj.stl is not an STL file: it is an OBJ file" in error_line(result)
+    assert not (tmp_path / "out").exists()
+
+
 def test_off_and_ply_with_quads_and_polygons(tmp_path):
     # a 3 × 2 grid of quads and a pentagon closing one side
     x, y = np.meshgrid(np.arange(4.0), np.arange(3.0))

@@ -18,7 +18,7 @@ import numpy as np
 from ..geometry.mesh import MeshError
 from .dxf import INSUNITS
 
-__all__ = ["DXF_UNITS", "PolygonSoup", "read_dxf", "read_obj", "read_off"]
+__all__ = ["DXF_UNITS", "PolygonSoup", "check_stl", "read_dxf", "read_obj", "read_off"]
 
 
 @dataclass
@@ -164,6 +164,61 @@ def read_off(path: Path) -> PolygonSoup:
         size = _numbers(tokens[:1], path, number, int)[0]
         faces.append(_numbers(tokens[1 : 1 + size], path, number, int))
     return _soup(points, faces, path)
+
+
+#: A line of an ASCII STL file that does not begin with one of its keywords.
+_NOT_STL_LINE = re.compile(
+    rb"^[ \t]*(?!(?:solid|facet|outer|vertex|endloop|endfacet|endsolid)\b)\S[^\r\n]*",
+    re.MULTILINE | re.IGNORECASE,
+)
+
+
+def check_stl(path: Path) -> None:
+    """Refuse a file named ``.stl`` that is no STL (meshio reads any text as ASCII STL, taking
+    the last three numbers of every line, so an OBJ renamed ``.stl`` became scattered
+    triangles): a binary STL is ``84 + 50·n`` bytes for the ``n`` triangles its header
+    announces; an ASCII STL begins with ``solid`` and has only its keywords' lines (``facet``,
+    ``outer loop``, ``vertex``, ``endloop``, ``endfacet``, ``endsolid``)."""
+    data = Path(path).read_bytes()
+    size = len(data)
+    announced = int.from_bytes(data[80:84], "little") if size >= 84 else None
+    if announced is not None and size == 84 + 50 * announced:
+        return  # binary
+    binary = b"\x00" in data[:4096]
+    if not data.lstrip()[:5].lower() == b"solid" or binary:
+        if binary and announced is not None:
+            raise MeshError(
+                f"{path} is not an STL file: a binary STL of the {announced} triangles its "
+                f"header announces has 84 + 50·{announced} = {84 + 50 * announced} bytes, this "
+                f"file has {size} (cut short, or another format)"
+            )
+        lines = data.decode("utf-8", errors="replace").splitlines()
+        vertices = sum(1 for line in lines if line.startswith("v "))
+        faces = sum(1 for line in lines if line.startswith("f "))
+        if vertices and faces:
+            raise MeshError(
+                f"{path} is not an STL file: it is an OBJ file ({vertices} 'v' and {faces} "
+                "'f' lines); name it .obj"
+            )
+        raise MeshError(
+            f"{path} is not an STL file: an ASCII STL begins with 'solid', a binary one is "
+            "84 + 50·n bytes for its n triangles"
+        )
+    if binary:
+        raise MeshError(
+            f"{path} is not an STL file: it begins with 'solid' as an ASCII STL does but holds "
+            "binary data, and its size fits no binary STL"
+        )
+    stray = _NOT_STL_LINE.search(data, data.find(b"\n") + 1 or size)  # after "solid name"
+    if stray is not None:
+        number = data.count(b"\n", 0, stray.start()) + 1
+        line = stray.group().decode("utf-8", errors="replace").strip()
+        raise MeshError(
+            f"{path}, line {number}: {line[:60]!r} is no line of an ASCII STL file (solid, "
+            "facet, outer loop, vertex, endloop, endfacet, endsolid)"
+        )
+    if not re.search(rb"^[ \t]*vertex\b", data, re.MULTILINE | re.IGNORECASE):
+        raise MeshError(f"{path} is an ASCII STL file without facets (no 'vertex' lines)")
 
 
 def _text(path: Path) -> str:

@@ -19,7 +19,7 @@ from ..geometry.repair import RepairReport
 from ..geometry.repair import repair as repair_surface
 from ..units import METRES
 from .files import write_with
-from .formats import read_dxf, read_obj, read_off
+from .formats import check_stl, read_dxf, read_obj, read_off
 from .vtu import FACTOR_FIELD, declare_units, declared_units, split_string_fields
 
 __all__ = [
@@ -204,6 +204,8 @@ def read_raw(path: Path) -> RawSurface:
     if suffix in (".obj", ".off"):
         soup = read_obj(path) if suffix == ".obj" else read_off(path)
         return RawSurface(soup.points, soup.cells, soup.polygons)
+    if suffix == ".stl":
+        check_stl(path)
     return _read_meshio(path)
 
 
