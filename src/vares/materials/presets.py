@@ -12,7 +12,10 @@ test values. Your own presets go in a TOML file of the same form::
     nu12 = 0.38     # Poisson's ratio warp → fill
     source = "our biaxial test report 2026-031"
 
-and are loaded with :func:`load_presets` (``vares pattern --presets FILE``).
+and are loaded with :func:`load_presets` (``vares pattern --presets FILE``). A fabric file
+written by ``vares fabric fit`` (:mod:`vares.materials.fabric_file`) is such a file whose entry
+also holds the measured compensation values and how the numbers were found; its path stands
+for its one fabric (``fabric("pes-batch-42.toml")``, ``--fabric pes-batch-42.toml``).
 """
 
 from __future__ import annotations
@@ -24,15 +27,20 @@ from pathlib import Path
 
 from .anisotropic import OrthotropicStVenantKirchhoff
 from .base import MaterialError
+from .fabric_file import COMPENSATE_BY, EXTRA_KEYS, MeasuredCompensation, read_test_tables
 
-__all__ = ["FabricPreset", "fabric", "load_presets", "presets"]
+__all__ = ["FabricPreset", "fabric", "file_fabric", "load_presets", "presets"]
 
 _FIELDS = {"E1", "E2", "G12", "nu12"}
 
 
 @dataclass(frozen=True)
 class FabricPreset:
-    """A named orthotropic fabric (stiffnesses as force per length, use thickness 1)."""
+    """A named orthotropic fabric (stiffnesses as force per length, use thickness 1).
+
+    A fabric from biaxial tests also has its measured ``compensation`` values and the way a
+    pattern is compensated by default (``compensate_by``: ``"measured"`` or ``"law"``).
+    """
 
     name: str
     description: str
@@ -41,9 +49,28 @@ class FabricPreset:
     G12: float
     nu12: float
     source: str
+    compensation: MeasuredCompensation | None = None
+    compensate_by: str = "law"
 
-    def material(self) -> OrthotropicStVenantKirchhoff:
-        return OrthotropicStVenantKirchhoff(self.E1, self.E2, self.G12, self.nu12)
+    def material(self, compensate_by: str | None = None) -> OrthotropicStVenantKirchhoff:
+        """The fabric's law; with ``compensate_by="measured"`` (default: the preset's choice)
+        the law through the measured compensation values instead
+        (:func:`vares.materials.fitting.compensating_law`: a flat panel under the tested
+        prestress is compensated by exactly those strains)."""
+        choice = compensate_by or self.compensate_by
+        if choice not in COMPENSATE_BY:
+            raise MaterialError(f"compensate_by must be one of {', '.join(COMPENSATE_BY)}")
+        if choice == "law":
+            return OrthotropicStVenantKirchhoff(self.E1, self.E2, self.G12, self.nu12)
+        if self.compensation is None:
+            raise MaterialError(
+                f"fabric {self.name!r} has no measured compensation values: compensate by its "
+                "law, or fit it with compensation records ('vares fabric fit --compensation')"
+            )
+        from .fitting import compensating_law
+
+        c = self.compensation
+        return compensating_law(c.warp, c.fill, c.prestress, self.nu12, self.G12)
 
 
 def _parse(text: str, origin: str) -> dict[str, FabricPreset]:
@@ -58,7 +85,7 @@ def _parse(text: str, origin: str) -> dict[str, FabricPreset]:
         missing = sorted(_FIELDS - set(entry))
         if missing:
             raise MaterialError(f"{origin}: [{name}] lacks {', '.join(missing)}")
-        unknown = sorted(set(entry) - _FIELDS - {"description", "source"})
+        unknown = sorted(set(entry) - _FIELDS - {"description", "source"} - EXTRA_KEYS)
         if unknown:
             raise MaterialError(f"{origin}: [{name}] has unknown keys {', '.join(unknown)}")
         if not str(entry.get("source", "")).strip():
@@ -71,8 +98,14 @@ def _parse(text: str, origin: str) -> dict[str, FabricPreset]:
             raise MaterialError(
                 f"{origin}: [{name}]: E1, E2, G12 and nu12 must be numbers"
             ) from exc
+        compensation, choice = read_test_tables(entry, f"{origin}: [{name}]")
         preset = FabricPreset(
-            name, str(entry.get("description", name)), source=str(entry["source"]), **values
+            name,
+            str(entry.get("description", name)),
+            source=str(entry["source"]),
+            compensation=compensation,
+            compensate_by=choice or ("measured" if compensation else "law"),
+            **values,
         )
         try:
             preset.material()
@@ -97,8 +130,23 @@ def load_presets(path: str | Path) -> dict[str, FabricPreset]:
 
 
 def fabric(name: str, extra: str | Path | None = None) -> FabricPreset:
-    """A preset by name, from the shipped catalogue or (first) from the file ``extra``."""
+    """A preset by name, from the shipped catalogue or (first) from the file ``extra``; or the
+    one fabric of a fabric file, named by its path (ending in ``.toml``)."""
+    if extra is None and str(name).endswith(".toml"):
+        return file_fabric(name)
     catalogue = presets() | (load_presets(extra) if extra is not None else {})
     if name not in catalogue:
         raise MaterialError(f"unknown fabric preset {name!r}; known: {', '.join(catalogue)}")
     return catalogue[name]
+
+
+def file_fabric(path: str | Path) -> FabricPreset:
+    """The one fabric of a fabric file (a preset file of one entry, as ``vares fabric fit``
+    writes); a file of several names them."""
+    catalogue = load_presets(path)
+    if len(catalogue) != 1:
+        raise MaterialError(
+            f"{path} holds {len(catalogue)} fabrics ({', '.join(catalogue) or 'none'}): name "
+            "one (--fabric NAME --presets FILE)"
+        )
+    return next(iter(catalogue.values()))
