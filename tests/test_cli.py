@@ -269,6 +269,26 @@ def test_ncf_and_evaluate_ply_check(tmp_path):
     assert result.exit_code == 2 and "nodes and faces" in error_line(result)
 
 
+def test_evaluate_names_the_nodes_of_a_pattern_that_is_not_finite(tmp_path):
+    mesh = hypar(size=4.0, rise=0.15, n=6)
+    surface = tmp_path / "surface.obj"
+    meshio.write(surface, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    flat = np.column_stack([mesh.points[:, :2], np.zeros(mesh.num_points)])
+    flat[[5, 17], 0] = np.nan
+    flat[30, 1] = np.inf
+    pattern = tmp_path / "pattern.obj"
+    meshio.write(pattern, meshio.Mesh(flat, [("triangle", mesh.cells["triangle"])]))
+    result = run("evaluate", surface, pattern, "-o", tmp_path / "check", "--E", 100, "--nu", 0.3)
+    assert result.exit_code == 2
+    line = error_line(result)
+    assert "pattern.obj: the pattern's coordinates are not finite" in line
+    assert line.endswith("at nodes 5, 17, 30") and "inverts" not in line
+    assert not (tmp_path / "check").exists()
+    material = vares.materials.NeoHooke(E=100.0, nu=0.3)
+    with pytest.raises(ValueError, match=r"not finite .* at nodes 5, 17, 30$"):
+        vares.evaluate(mesh, flat[:, :2], material)
+
+
 def test_material_option_errors(tmp_path):
     result = run("example", "hypar", "-o", tmp_path / "o", "--material", "orthotropic", "--E1", 800)
     assert result.exit_code == 2 and "orthotropic needs E2, G12, nu12" in error_line(result)

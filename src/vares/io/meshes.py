@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.elements import ELEMENTS
-from ..geometry.mesh import MeshError, SurfaceMesh, connected_pieces
+from ..geometry.mesh import MeshError, SurfaceMesh, _listing, connected_pieces
 from ..geometry.repair import RepairReport
 from ..geometry.repair import repair as repair_surface
 from ..units import METRES
@@ -365,6 +365,12 @@ def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
     if not same:
         raise MeshError(f"{path} does not have the nodes and faces of the surface mesh")
     points = np.asarray(raw.points, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if bad.size:
+        raise MeshError(
+            f"{path}: the pattern's coordinates are not finite (NaN or inf) at nodes "
+            f"{_listing(bad)}"
+        )
     height = np.ptp(points[:, 2]) if points.shape[1] == 3 else 0.0
     if height > 1e-9 * np.ptp(points[:, :2]):
         raise MeshError(f"{path} is not flat (its z varies): not a pattern")
