@@ -14,6 +14,7 @@ import numpy as np
 
 from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, STRUCTURE_EXAMPLES
 from ..materials import LAWS, Hyperelastic, fabric, make_material
+from ..materials.presets import file_fabric
 from ..mechanics.fields import FIELD_DESCRIPTIONS
 from ..options import Options, OptionsError, option
 from ..units import METRES
@@ -126,10 +127,22 @@ class MaterialOptions(Options):
         flags=("--material", "-m"),
     )
     fabric: str | None = option(
-        None, "str", "Fabric preset (see 'vares fabrics'); replaces the law.", section="material"
+        None,
+        "str",
+        "Fabric preset (see 'vares fabrics'), or a fabric file (.toml, e.g. from 'vares fabric "
+        "fit'); replaces the law.",
+        section="material",
     )
     presets: str | None = option(
         None, "path", "TOML file with your own fabric presets.", section="material"
+    )
+    compensate_by: str | None = option(
+        None,
+        "str",
+        "A fabric from biaxial tests compensates the pattern by its 'measured' compensation "
+        "values or by its fitted 'law' (default: the fabric file's choice).",
+        section="material",
+        choices=("measured", "law"),
     )
     thickness: float = option(
         1.0,
@@ -158,16 +171,25 @@ class MaterialOptions(Options):
 
     def check(self) -> None:
         parameters = [k for k in _LAW_PARAMETERS if getattr(self, k) is not None]
-        if self.fabric is not None and (self.law is not None or parameters):
+        if self.fabric is not None and self.fabric.endswith(".toml"):
+            if self.presets is not None:
+                raise OptionsError(None, "give a fabric file or presets, not both")
+            # a fabric file is a presets file of one fabric: kept as a path of the job
+            object.__setattr__(self, "presets", self.fabric)
+            object.__setattr__(self, "fabric", None)
+        named = self.fabric is not None or self.presets is not None
+        if named and (self.law is not None or parameters):
             raise OptionsError(None, "a fabric preset sets the material: give no law or parameters")
-        if self.presets is not None and self.fabric is None:
-            raise OptionsError(None, "presets needs fabric")
+        if self.compensate_by is not None and not named:
+            raise OptionsError(None, "compensate_by needs a fabric")
 
     def build(self, base: Path) -> Hyperelastic:
         """The material (``base``: the folder a relative presets path is relative to)."""
-        if self.fabric is not None:
+        if self.fabric is not None or self.presets is not None:
             presets = None if self.presets is None else base / self.presets
-            return fabric(self.fabric, presets).material()
+            if self.fabric is None:
+                return file_fabric(presets).material(self.compensate_by)
+            return fabric(self.fabric, presets).material(self.compensate_by)
         law = self.law or DEFAULT_LAW
         given = {k: getattr(self, k) for k in _LAW_PARAMETERS if getattr(self, k) is not None}
         parameters = LAW_DEFAULTS.get(law, {}) | {

@@ -8,6 +8,7 @@ from .batch import batch
 from .cut import cut
 from .erect import erect
 from .evaluate import evaluate
+from .fabric import fabric_app
 from .fabrics import fabrics
 from .panels import panels
 from .pattern import example, pattern
@@ -23,6 +24,7 @@ app = typer.Typer(
 )
 for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch):
     app.command()(command)
+app.add_typer(fabric_app, name="fabric")
 
 
 def _print_version(value: bool) -> None:

@@ -1,0 +1,191 @@
+"""``vares fabric fit``: a fabric file from biaxial test records (docs/fabrics.md)."""
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import console, guarded
+from .flags import InputError
+
+__all__ = ["fabric_app", "fit"]
+
+fabric_app = typer.Typer(
+    help="Fabrics from biaxial tests: fit constants and compensation values to test records.",
+    no_args_is_help=True,
+)
+
+
+def _pair(text: str | None, flag: str) -> tuple[float, float] | None:
+    if text is None:
+        return None
+    parts = text.split(",")
+    try:
+        values = tuple(float(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 2 or not all(v > 0 for v in values):
+        raise InputError(f"{flag} takes two positive numbers 'warp,fill' (kN/m); got {text!r}")
+    return values[0], values[1]
+
+
+@fabric_app.command("fit")
+def fit(
+    files: Annotated[
+        list[Path],
+        typer.Argument(
+            metavar="FILE...",
+            help="Biaxial test records (CSV/TSV), one per specimen or test: MSAJ/M-02 load "
+            "ratio records give the constants, EN 17117-2 records the compensation values.",
+        ),
+    ],
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="The fabric file to write (.toml).")
+    ],
+    prestress: Annotated[
+        str | None,
+        typer.Option(
+            help="The project's prestress 'warp,fill' (kN/m): compensation values are read there."
+        ),
+    ] = None,
+    name: Annotated[
+        str | None, typer.Option(help="The fabric's name (default: the output file's stem).")
+    ] = None,
+    cycle: Annotated[
+        int,
+        typer.Option(help="The cycle of each load ratio the constants are fitted to (-1: last)."),
+    ] = -1,
+    reciprocal: Annotated[
+        bool,
+        typer.Option(
+            "--reciprocal/--no-reciprocal",
+            help="Fit with the reciprocity constraint nu_wf/E_w = nu_fw/E_f.",
+        ),
+    ] = True,
+    G12: Annotated[
+        float | None,
+        typer.Option("--G12", help="Shear stiffness (kN/m); biaxial tests do not measure it."),
+    ] = None,
+    shear_from: Annotated[
+        str,
+        typer.Option(help="Preset whose G12 is taken when --G12 is not given."),
+    ] = "pes-pvc-type-2",
+    compensate_by: Annotated[
+        str | None,
+        typer.Option(
+            help="The file's default compensation of a pattern: 'measured' (the compensation "
+            "values; default when there are any) or 'law' (the fitted law)."
+        ),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite the output file.")] = False,
+) -> None:
+    """Fit a fabric to biaxial test records and write a fabric file for --fabric.
+
+    The constants E_w, E_f, nu_wf (E1, E2, nu12) are fitted by least squares of the strain
+    residual over the load ratios of the chosen cycle (MSAJ/M-02), per specimen; the file holds
+    their mean and scatter, the compensation values at --prestress (EN 17117-2) and where
+    every number came from.
+    """
+
+    def body() -> None:
+        from ...io.biaxial import read_biaxial
+        from ...io.files import check_writable, write_text
+        from ...materials import fabric
+        from ...materials.fitting import fit_fabric
+
+        if output.suffix != ".toml":
+            raise InputError(f"--output must end in .toml; got {output}")
+        if compensate_by not in (None, "measured", "law"):
+            raise InputError(f"--compensate-by takes measured or law; got {compensate_by!r}")
+        pair = _pair(prestress, "--prestress")
+        check_writable([output], force)
+        if G12 is not None:
+            if not G12 > 0:
+                raise InputError(f"--G12 must be positive; got {G12:g}")
+            shear, shear_source = G12, "given (--G12)"
+        else:
+            shear, shear_source = fabric(shear_from).G12, f"from preset {shear_from}"
+        records = [read_biaxial(path) for path in files]
+        fitted = fit_fabric(
+            records,
+            name=name or output.stem,
+            G12=shear,
+            G12_source=shear_source,
+            prestress=pair,
+            cycle=cycle,
+            reciprocal=reciprocal,
+        )
+        write_text(output, fitted.to_toml(compensate_by))
+        _show(fitted)
+        console.print(f"wrote {output}")
+
+    guarded(body)
+
+
+def _show(fitted) -> None:
+    from rich.table import Table
+
+    table = Table(
+        "specimen",
+        "E1 (warp)",
+        "E2 (fill)",
+        "nu12",
+        "nu21",
+        "rms residual",
+        "nonlinear rms",
+        title="fitted constants (kN/m; ± standard error of the fit)",
+    )
+    for f in fitted.fits:
+        e = f.standard_errors
+        table.add_row(
+            f.name,
+            f"{f.E_w:.1f} ± {e['E_w']:.1f}",
+            f"{f.E_f:.1f} ± {e['E_f']:.1f}",
+            f"{f.nu_wf:.3f} ± {e['nu_wf']:.3f}",
+            f"{f.nu_fw:.3f} ± {e['nu_fw']:.3f}",
+            f"{f.rms:.2e}",
+            f"{f.nonlinear.get('rms', float('nan')):.2e}" + (" *" if f.linear_is_poor else ""),
+        )
+    m, s = fitted.constants.mean, fitted.constants.std
+    table.add_row(
+        "mean ± std",
+        f"{m['E_w']:.1f} ± {s['E_w']:.1f}",
+        f"{m['E_f']:.1f} ± {s['E_f']:.1f}",
+        f"{m['nu_wf']:.3f} ± {s['nu_wf']:.3f}",
+        f"{m['nu_fw']:.3f} ± {s['nu_fw']:.3f}",
+        "",
+        "",
+    )
+    console.print(table)
+    if any(f.linear_is_poor for f in fitted.fits):
+        console.print(
+            "* the nonlinear response ε = Cσ + (k_w σ_w², k_f σ_f²) fits markedly better: the "
+            "linear constants are secant values over the tested range"
+        )
+    residuals = Table(
+        "specimen", "ratio", "rms warp", "rms fill", title="strain residual per load ratio"
+    )
+    for f in fitted.fits:
+        for r in f.residuals:
+            residuals.add_row(f.name, r.label, f"{r.rms_warp:.2e}", f"{r.rms_fill:.2e}")
+    console.print(residuals)
+    console.print(f"G12 = {fitted.G12:g} kN/m {fitted.G12_source} (not measured by biaxial tests)")
+    if fitted.compensation is not None and fitted.prestress is not None:
+        values = Table(
+            "specimen",
+            "warp",
+            "fill",
+            title=f"compensation values at {fitted.prestress[0]:g}/{fitted.prestress[1]:g} kN/m",
+        )
+        for c in fitted.compensations:
+            values.add_row(c.name, f"{100 * c.warp:.3f} %", f"{100 * c.fill:.3f} %")
+        cm, cs = fitted.compensation.mean, fitted.compensation.std
+        values.add_row(
+            "mean ± std",
+            f"{100 * cm['warp']:.3f} ± {100 * cs['warp']:.3f} %",
+            f"{100 * cm['fill']:.3f} ± {100 * cs['fill']:.3f} %",
+        )
+        law = fitted.law_compensation()
+        if law is not None:
+            values.add_row("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %")
+        console.print(values)
