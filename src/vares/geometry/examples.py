@@ -53,6 +53,7 @@ __all__ = [
     "grid_cells",
     "hypar",
     "hypar_strips",
+    "irregular_cap",
     "irregular_hypar_strips",
     "real_world_suite",
     "rib30",
@@ -315,6 +316,44 @@ def spherical_cap(
             radius * np.sin(theta) * np.sin(polar[:, 1]),
             radius * np.cos(theta),
         ]
+    )
+    return SurfaceMesh(points, {"triangle": _counter_clockwise(plane, triangles)})
+
+
+def irregular_cap(
+    radius: float = 100.0,
+    half_angle: float = 90.0,
+    n_rings: int = 40,
+    jitter: float = 0.3,
+    seed: int = 0,
+) -> SurfaceMesh:
+    """:func:`spherical_cap` with irregular triangles: every node but the pole and the edge ring
+    moved at random along the sphere by up to ``jitter`` ring spacings in each of the polar and
+    the azimuthal direction (reproducible by ``seed``), then triangulated anew (Delaunay in the
+    azimuthal equidistant plane). The pole stays a node at ``(0, 0, radius)``."""
+    from scipy.spatial import Delaunay
+
+    if not 0 < half_angle < 180:
+        raise ValueError(f"half_angle must lie in (0, 180) degrees; got {half_angle}")
+    if not 0 <= jitter < 0.5:
+        raise ValueError(f"jitter must lie in [0, 0.5) ring spacings; got {jitter}")
+    rng = np.random.default_rng(seed)
+    rings, phis = [np.zeros(1)], [np.zeros(1)]
+    for ring in range(1, n_rings + 1):
+        count = 6 * ring
+        phi = 2 * np.pi * (np.arange(count) + 0.5 * (ring % 2)) / count
+        level = np.full(count, float(ring))
+        if ring < n_rings:
+            level += jitter * rng.uniform(-1, 1, count)
+            phi += jitter * rng.uniform(-1, 1, count) / ring
+        rings.append(level / n_rings)
+        phis.append(phi)
+    theta = np.radians(half_angle) * np.concatenate(rings)
+    phi = np.concatenate(phis)
+    plane = np.column_stack([theta * np.cos(phi), theta * np.sin(phi)])
+    triangles = Delaunay(plane).simplices
+    points = radius * np.column_stack(
+        [np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)]
     )
     return SurfaceMesh(points, {"triangle": _counter_clockwise(plane, triangles)})
 

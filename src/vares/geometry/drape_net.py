@@ -1,0 +1,326 @@
+"""Kinematic drape: the pin-jointed net ("fishnet") of a woven ply laid on a mould.
+
+The yarns are inextensible and free to shear at their crossings. From a **seed point** on the
+mould and a **warp direction** there, two generator yarns run from the seed along ±warp and ±fill
+(fill ⟂ warp in the seed's tangent plane): geodesics of the triangulated mould (potpourri3d's
+tracer: straightest paths on the polyhedral surface) or polylines the user gives. Along them the
+net nodes follow each other at the chord distance ``spacing``. Every other node ``(i, j)`` is the
+point of the mould at the distance ``spacing`` from both ``(i ∓ 1, j)`` and ``(i, j ∓ 1)`` (the
+intersection of two spheres with the surface, Mack & Taylor 1956, Van der Weeën 1991), on the side
+away from the diagonal node ``(i ∓ 1, j ∓ 1)``. On the triangle mesh that point is exact: the
+circle where the two spheres meet is intersected with the plane of a face, and the search walks
+across faces until the intersection lies inside the face it was computed with. The nodes are found
+by anti-diagonals ``|i| + |j| = k``, all nodes of one diagonal (in all four quadrants) at once.
+
+The shear angle is the decrease of the angle between the yarns from 90°, signed: the angle between
+the +warp and +fill yarns of the grid. On a surface of Gauss curvature ``K`` it is ``γ ≈ K u v``
+near the seed (``u = i·spacing``, ``v = j·spacing``, signed yarn lengths from the seed); on a
+sphere exactly ``γ = f(K u v)`` with ``z f'' + f' = cos f``, ``f(0) = 0`` (Chebyshev nets, see
+docs/composites.md). The net implies a flat pattern: the node ``(i, j)`` goes to ``(u, v)``.
+:func:`vares.geometry.drape.kinematic_drape` carries the net onto the mould's own cells and
+nodes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .mesh import SurfaceMesh
+from .surface_lines import triangulated
+from .surface_points import FaceLocator, barycentric, face_neighbours
+
+__all__ = ["DrapeError", "KinematicNet", "chord_nodes", "kinematic_net", "yarn_shear"]
+
+
+class DrapeError(ValueError):
+    """A drape that cannot be made (the seed is off the mould, a generator is too short, …)."""
+
+
+@dataclass(frozen=True)
+class KinematicNet:
+    """The nodes of a kinematic drape on a ``(nu, nv)`` grid (warp index first).
+
+    ``positions`` ``(nu, nv, 3)``: the nodes on the mould, NaN where the net does not reach
+    (outside the mould, or beyond a cell that would shear past 90°); ``faces`` ``(nu, nv)``: the
+    triangle of the (triangulated) mould each node lies in, −1 where there is none; ``seed``: the
+    grid index of the seed node; ``spacing``: the yarn spacing (length units of the mesh).
+    """
+
+    positions: np.ndarray
+    faces: np.ndarray
+    seed: tuple[int, int]
+    spacing: float
+
+    @property
+    def valid(self) -> np.ndarray:
+        """``(nu, nv)`` bool: where the net has a node."""
+        return self.faces >= 0
+
+    @property
+    def yarn_lengths(self) -> tuple[np.ndarray, np.ndarray]:
+        """Signed yarn lengths from the seed: ``u = (i − seed_i)·spacing`` ``(nu, 1)`` along the
+        warp and ``v = (j − seed_j)·spacing`` ``(1, nv)`` along the fill."""
+        nu, nv = self.faces.shape
+        u = (np.arange(nu) - self.seed[0])[:, None] * self.spacing
+        v = (np.arange(nv) - self.seed[1])[None, :] * self.spacing
+        return u, v
+
+    @property
+    def flat(self) -> np.ndarray:
+        """The flat pattern of the nodes ``(nu, nv, 2)``: ``(u, v)``, NaN where there is no node."""
+        u, v = self.yarn_lengths
+        flat = np.stack(np.broadcast_arrays(u, v), axis=-1).astype(float)
+        flat[~self.valid] = np.nan
+        return flat
+
+    @property
+    def node_shear(self) -> np.ndarray:
+        """Shear angle at each node ``(nu, nv)`` in degrees, from the yarns through the node's
+        two neighbours on each side (centred: second-order accurate); NaN at the net's edge."""
+        p = self.positions
+        nan = np.full_like(p[:1], np.nan)
+        warp = np.concatenate([nan, p[2:] - p[:-2], nan], axis=0)
+        nan = np.full_like(p[:, :1], np.nan)
+        fill = np.concatenate([nan, p[:, 2:] - p[:, :-2], nan], axis=1)
+        return yarn_shear(warp, fill)
+
+    @property
+    def cell_shear(self) -> np.ndarray:
+        """Shear angle of each net cell ``(nu − 1, nv − 1)`` in degrees: between the mean warp
+        (its two warp sides) and the mean fill (its two fill sides); NaN for incomplete cells."""
+        warp, fill = self.cell_yarns()
+        return yarn_shear(warp, fill)
+
+    def cell_yarns(self) -> tuple[np.ndarray, np.ndarray]:
+        """The mean warp and fill vectors of every net cell, ``(nu − 1, nv − 1, 3)`` each (sums
+        of the cell's two sides of each family: twice the mean)."""
+        p = self.positions
+        warp = (p[1:, :-1] - p[:-1, :-1]) + (p[1:, 1:] - p[:-1, 1:])
+        fill = (p[:-1, 1:] - p[:-1, :-1]) + (p[1:, 1:] - p[1:, :-1])
+        return warp, fill
+
+
+def yarn_shear(warp: np.ndarray, fill: np.ndarray) -> np.ndarray:
+    """Shear angles ``(...)`` in degrees, ``90° − ∠(warp, fill)``, of yarn vectors ``(..., 3)``."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cosine = np.einsum("...i,...i->...", warp, fill) / (
+            np.linalg.norm(warp, axis=-1) * np.linalg.norm(fill, axis=-1)
+        )
+    return 90.0 - np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def chord_nodes(polyline: np.ndarray, spacing: float) -> np.ndarray:
+    """Points ``(k, 3)`` along a polyline ``(p, 3)``, each at the straight distance ``spacing``
+    from the one before, the first from the polyline's start (which is not included); as many as
+    fit before the polyline ends."""
+    polyline = np.asarray(polyline, dtype=float)
+    nodes, current, segment = [], polyline[0], 0
+    while segment < len(polyline) - 1:
+        ahead = np.linalg.norm(polyline[segment + 1 :] - current, axis=1)
+        beyond = np.flatnonzero(ahead >= spacing)
+        if not beyond.size:
+            break
+        end = segment + 1 + int(beyond[0])
+        a, b = polyline[end - 1], polyline[end]
+        # |a + t (b − a) − current| = spacing, the root in [0, 1] (a is nearer than spacing)
+        d, w = b - a, a - current
+        qa, qb, qc = d @ d, 2 * d @ w, w @ w - spacing**2
+        t = (-qb + np.sqrt(max(qb * qb - 4 * qa * qc, 0.0))) / (2 * qa)
+        current = a + t * d
+        nodes.append(current)
+        segment = end - 1
+    return np.array(nodes).reshape(-1, 3)
+
+
+def kinematic_net(
+    mesh: SurfaceMesh,
+    seed: np.ndarray,
+    warp_direction: np.ndarray,
+    spacing: float,
+    *,
+    generators: tuple[np.ndarray, np.ndarray] | None = None,
+    max_length: float | None = None,
+) -> KinematicNet:
+    """The kinematic drape's net from ``seed`` ``(3,)`` with the warp along ``warp_direction``
+    ``(3,)`` (projected onto the mould's tangent plane at the seed) and yarns ``spacing`` apart.
+
+    ``generators``: the warp and fill generator yarns as polylines ``(p, 3)`` on the mould through
+    the seed (each is split at its point nearest the seed; the half whose start points along
+    ``warp_direction``, respectively the fill, is the + half), instead of the geodesics.
+    ``max_length``: the longest generator yarn each way (default: twice the mould's bounding-box
+    diagonal). Quads are triangulated first.
+    """
+    if not spacing > 0:
+        raise DrapeError(f"the yarn spacing must be positive; got {spacing}")
+    tri_mesh = triangulated(mesh)
+    triangles = tri_mesh.cells["triangle"]
+    locator = FaceLocator(tri_mesh)
+    size = float(np.linalg.norm(np.ptp(tri_mesh.points, axis=0)))
+    seed = np.asarray(seed, dtype=float).reshape(3)
+    face, bary, seed_point = (a[0] for a in locator.locate(seed[None]))
+    reach = np.ptp(tri_mesh.points[triangles[face]], axis=0).max()
+    if np.linalg.norm(seed_point - seed) > reach:
+        raise DrapeError(f"the seed {seed} is not on the mould (nearest point {seed_point})")
+    normal, vertex = _seed_normal(tri_mesh, face, bary, size)
+    warp = np.asarray(warp_direction, dtype=float).reshape(3)
+    warp = warp - (warp @ normal) * normal
+    if np.linalg.norm(warp) < 1e-9 * max(1.0, float(np.linalg.norm(warp_direction))):
+        raise DrapeError("the warp direction is normal to the mould at the seed")
+    warp /= np.linalg.norm(warp)
+    fill = np.cross(normal, warp)
+    if generators is None:
+        length = 2.0 * size if max_length is None else float(max_length)
+        yarns = _geodesic_generators(tri_mesh, face, bary, vertex, warp, fill, length)
+    else:
+        yarns = _given_generators(generators, seed_point, warp, fill)
+    warp_minus, warp_plus, fill_minus, fill_plus = (chord_nodes(y, spacing) for y in yarns)
+
+    nu = len(warp_minus) + 1 + len(warp_plus)
+    nv = len(fill_minus) + 1 + len(fill_plus)
+    si, sj = len(warp_minus), len(fill_minus)
+    positions = np.full((nu, nv, 3), np.nan)
+    positions[si, sj] = seed_point
+    positions[si + 1 :, sj] = warp_plus
+    positions[:si, sj] = warp_minus[::-1]
+    positions[si, sj + 1 :] = fill_plus
+    positions[si, :sj] = fill_minus[::-1]
+    faces = np.full((nu, nv), -1, dtype=np.int64)
+    on_axes = np.isfinite(positions[..., 0])
+    faces[on_axes] = locator.locate(positions[on_axes])[0]
+    faces[si, sj] = face
+    _march(positions, faces, (si, sj), spacing, tri_mesh.points[triangles], triangles)
+    return KinematicNet(positions, faces, (si, sj), float(spacing))
+
+
+def _seed_normal(mesh: SurfaceMesh, face: int, bary: np.ndarray, size: float):
+    """The unit normal at the seed (the face's, or the mean of the faces round a node) and the
+    node the seed sits on (None if it lies inside a face or an edge)."""
+    triangles = mesh.cells["triangle"]
+    corner = int(np.argmax(bary))
+    node = int(triangles[face, corner])
+    vectors = mesh.area_vectors()
+    if np.linalg.norm(mesh.points[node] - bary @ mesh.points[triangles[face]]) <= 1e-9 * size:
+        normal = vectors[(triangles == node).any(axis=1)].sum(axis=0)
+        return normal / np.linalg.norm(normal), node
+    return vectors[face] / np.linalg.norm(vectors[face]), None
+
+
+def _geodesic_generators(mesh, face, bary, vertex, warp, fill, length) -> list[np.ndarray]:
+    import potpourri3d as pp3d
+
+    tracer = pp3d.GeodesicTracer(mesh.points, mesh.cells["triangle"])
+    yarns = []
+    for direction in (-warp, warp, -fill, fill):
+        if vertex is not None:
+            path = tracer.trace_geodesic_from_vertex(vertex, direction * length)
+        else:
+            path = tracer.trace_geodesic_from_face(int(face), bary, direction * length)
+        yarns.append(np.asarray(path, dtype=float))
+    return yarns
+
+
+def _given_generators(generators, seed, warp, fill) -> list[np.ndarray]:
+    halves = []
+    for polyline, direction in zip(generators, (warp, fill), strict=True):
+        polyline = np.asarray(polyline, dtype=float).reshape(-1, 3)
+        if len(polyline) < 2:
+            raise DrapeError("a generator yarn needs at least two points")
+        k = int(np.argmin(np.linalg.norm(polyline - seed, axis=1)))
+        ahead = np.vstack([seed, polyline[k + 1 :]]) if k + 1 < len(polyline) else seed[None]
+        behind = np.vstack([seed, polyline[:k][::-1]]) if k > 0 else seed[None]
+        if len(ahead) == 1 or (ahead[1] - seed) @ direction < 0:
+            ahead, behind = behind, ahead
+        halves += [behind, ahead]
+    return halves
+
+
+def _march(positions, faces, seed, spacing, corners, triangles, max_steps: int = 200) -> None:
+    """Fill the nodes off the generator yarns in place, by anti-diagonals from the seed."""
+    nu, nv = faces.shape
+    a, b = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    i, j = a - seed[0], b - seed[1]
+    level = np.abs(i) + np.abs(j)
+    inner = (i != 0) & (j != 0)
+    di, dj = np.sign(i), np.sign(j)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    neighbours = face_neighbours(triangles)
+    for k in range(2, int(level.max(initial=0)) + 1):
+        ta, tb = np.nonzero(inner & (level == k))
+        ia, jb = ta - di[ta, tb], tb - dj[ta, tb]
+        start = faces[ia, tb]
+        ready = (start >= 0) & (faces[ta, jb] >= 0) & (faces[ia, jb] >= 0)
+        ta, tb, ia, jb, start = ta[ready], tb[ready], ia[ready], jb[ready], start[ready]
+        if not ta.size:
+            continue
+        point, face = _sphere_intersections(
+            positions[ia, jb],
+            positions[ia, tb],
+            positions[ta, jb],
+            start,
+            spacing,
+            corners,
+            normals,
+            neighbours,
+            max_steps,
+        )
+        positions[ta, tb] = point
+        faces[ta, tb] = face
+
+
+def _sphere_intersections(p0, p1, p2, start, spacing, corners, normals, neighbours, max_steps):
+    """The points ``(k, 3)`` of the mesh at the distance ``spacing`` from both ``p1`` and ``p2``
+    ``(k, 3)``, on the side away from ``p0``, and their faces ``(k,)`` (NaN and −1 where there is
+    none), walking from the faces ``start``."""
+    count = len(p1)
+    chord = p2 - p1
+    distance = np.linalg.norm(chord, axis=1)
+    e = chord / distance[:, None]
+    centre = 0.5 * (p1 + p2)
+    radius_sq = spacing**2 - 0.25 * distance**2
+    radius = np.sqrt(np.clip(radius_sq, 0.0, None))
+    away = centre - p0
+    away -= np.einsum("ki,ki->k", away, e)[:, None] * e
+    with np.errstate(invalid="ignore", divide="ignore"):
+        along = away / np.linalg.norm(away, axis=1)[:, None]
+    across = np.cross(e, along)
+    point = np.full((count, 3), np.nan)
+    found = np.full(count, -1, dtype=np.int64)
+    face, previous = start.copy(), np.full(count, -1, dtype=np.int64)
+    active = np.flatnonzero(radius_sq > 1e-12 * spacing**2)  # else the cell shears past 90°
+    for _ in range(max_steps):
+        if not active.size:
+            break
+        f = face[active]
+        n = normals[f]
+        alpha = np.einsum("ki,ki->k", n, along[active])
+        beta = np.einsum("ki,ki->k", n, across[active])
+        rho = np.hypot(alpha, beta)
+        offset = np.einsum("ki,ki->k", n, corners[f, 0] - centre[active])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = offset / (radius[active] * rho)
+        reaches = np.abs(c) <= 1.0
+        phi, delta = np.arctan2(beta, alpha), np.arccos(np.clip(c, -1.0, 1.0))
+        theta = np.where(np.cos(phi + delta) >= np.cos(phi - delta), phi + delta, phi - delta)
+        q = centre[active] + radius[active, None] * (
+            np.cos(theta)[:, None] * along[active] + np.sin(theta)[:, None] * across[active]
+        )
+        lam, _ = barycentric(q, corners[f])
+        worst = np.argmin(lam, axis=1)
+        inside = lam[np.arange(len(f)), worst] >= -1e-9
+        step = neighbours[f, worst]
+        # stepping back to the face it came from: the root lies on the side the two share
+        back = ~inside & (step >= 0) & (step == previous[active]) & reaches
+        if back.any():
+            clamped = np.clip(lam[back], 0.0, None)
+            clamped /= clamped.sum(axis=1, keepdims=True)
+            q[back] = np.einsum("kc,kci->ki", clamped, corners[f[back]])
+        done = (inside | back) & reaches
+        point[active[done]], found[active[done]] = q[done], f[done]
+        moving = ~inside & ~back & (step >= 0)
+        previous[active[moving]] = f[moving]
+        face[active[moving]] = step[moving]
+        active = active[moving]
+    return point, found
