@@ -44,6 +44,9 @@ ENERGY_NOISE = 1e-13
 #: switch between taut, wrinkled and slack, Newton's method may stall well above round-off, and
 #: that is no convergence.
 ROUND_OFF_REGIME = 1e-11
+#: With the tension field, the line search hands over to damped steps when the residual has not
+#: halved in this many iterations (Newton's steps circling a solution where cells switch state).
+STALL_WINDOW = 10
 _ATTEMPTS = (Attempt("erection", None, "line-search"), Attempt("erection, damped", None, "damped"))
 
 
@@ -235,6 +238,9 @@ def erect(
             x, path, reason = follow_plan(problem, x, None, _ATTEMPTS, ctx, damping=1.0)
         except WrinklingError as exc:
             reason = str(exc)
+    fields = _fields(problem, x, structure, relaxed=options.wrinkling)
+    if reason is None:
+        reason = _not_in_equilibrium(problem, x, ctx, taut=not fields["state"].any())
     normals, node_areas = node_normals(mesh)
     return ErectionResult(
         mesh=mesh,
@@ -252,7 +258,7 @@ def erect(
         displacement=x - design,
         normal_deviation=np.einsum("ni,ni->n", x - design, normals),
         node_areas=node_areas,
-        fields=_fields(problem, x, structure, relaxed=options.wrinkling),
+        fields=fields,
         design_fields=_fields(problem, design, structure, relaxed=False),
         intended=structure.intended,
         held=held,
@@ -302,7 +308,27 @@ def _context(
         callback=callback,
         round_off_regime=ROUND_OFF_REGIME,
         loosest_forcing=ETA_MAX_KINKED if problem.wrinkling else ETA_MAX,
+        stall_window=STALL_WINDOW if problem.wrinkling else None,
     )
+
+
+def _not_in_equilibrium(problem: ErectionProblem, x, ctx: NewtonContext, taut: bool) -> str | None:
+    """Why ``x`` is no equilibrium, or None: the residual of the energy solved for (the relaxed
+    law's) and, where no cell wrinkles or hangs slack, that of the law as it is (the two agree
+    there) must be within the tolerance, or the round-off floor Newton's method stopped at."""
+    bound = max(ctx.residual_tolerance, ctx.round_off_regime * ctx.force_scale)
+    laws = [problem.wrinkling] + ([False] if taut and problem.wrinkling else [])
+    for relaxed in laws:
+        evaluation = problem.evaluate(x, order=1, relaxed=relaxed)
+        residual = float(np.linalg.norm(ctx.residual(ctx.assembler.vector(evaluation.gradients))))
+        if not residual <= bound:
+            law = "tension-field" if relaxed else "elastic"
+            return (
+                f"the state found is no equilibrium of the {law} law: residual "
+                f"{residual / ctx.force_scale:.3g} of the stiffness (at most "
+                f"{bound / ctx.force_scale:.3g})"
+            )
+    return None
 
 
 def _checked_start(start, design: np.ndarray) -> np.ndarray:

@@ -2,7 +2,7 @@
 displacement from the design and its normal component, and their statistics.
 
 Membrane forces are force per length: thickness × the Cauchy stress of the relaxed (or plain)
-law, without the regularising tension. A cell is **taut** when both principal forces are
+law. A cell is **taut** when both principal forces are
 positive, **wrinkled** when one is ≤ 0 < the other (uniaxial tension), **slack** when neither is
 positive (round-off of a stress-free state counts as zero). Means, RMS values and area fractions
 are weighted by the cells' areas on the design surface.
@@ -58,9 +58,8 @@ def membrane_forces(
         captured = {}
 
         def respond(C, tangent, fibres=block.fibres, captured=captured):
-            # the law's stresses, without the regularising tension
             psi, S, cc = problem.response(fibres, relaxed)(C, tangent)
-            captured["C"], captured["S"] = C, S - problem.tension * np.eye(2)
+            captured["C"], captured["S"] = C, S
             return psi, S, cc
 
         forward_block(block.reference, x[block.cells], respond, order=0)

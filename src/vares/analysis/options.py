@@ -57,10 +57,10 @@ class ErectionOptions(Options):
     regularisation: float = option(
         1e-6,
         "float",
-        "Fictitious isotropic tension in every cell, relative to the material's stiffness: slack "
-        "regions hang taut at it instead of having no determinate shape, and Newton's method "
-        "converges through wrinkling; not part of the reported forces (0 for a structure "
-        "without prestress).",
+        "Tension of a fictitious soap film, relative to the material's stiffness, whose "
+        "stiffness is added to Newton's tangent (never to the forces): it keeps the tangent "
+        "definite where cells wrinkle or hang slack; the state found is an equilibrium of the "
+        "law itself.",
         section="erection",
         minimum=0,
     )

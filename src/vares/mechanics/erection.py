@@ -9,15 +9,15 @@ welded structure (seam nodes shared), and the energy is
 
 (:mod:`vares.mechanics.forward`, :mod:`vares.mechanics.wrinkling`, :mod:`vares.mechanics.loads`).
 Slack regions carry no stiffness and have no determinate shape (any shape shorter than the
-fabric stores no energy); where cells switch between taut, wrinkled and slack the energy has
-kinks. A fictitious isotropic tension ``τ = ε k`` (``k`` the law's stiffness, ``ε`` =
-``regularisation``) in every cell, the energy ``τ (tr C − 2)/2`` of a soap film, makes slack
-regions hang taut at that tension, keeps the tangent positive definite in every direction (with
-the supports held) and lets Newton's method converge through the kinks. It adds ``τ`` to every
-membrane force (1e-6 of the stiffness by default: 1 N/m on a fabric of E·t = 1000 kN/m); the
-reported forces are the law's alone. A structure without any prestress is in equilibrium on its
-design shape only without it (``regularisation=0``): a stress-free membrane has no stiffness
-against a film tension and would move by ``ε^(1/3)`` of its span.
+fabric stores no energy), wrinkled ones none across their wrinkles, and where cells switch between
+taut, wrinkled and slack the energy has kinks. Newton's tangent is therefore *stabilised*: the
+Hessian of a fictitious soap film ``τ (tr C − 2)/2`` of tension ``τ = ε k`` (``k`` the law's
+stiffness, ``ε`` = ``regularisation``) is added to it, ``τ Σ_q w ∇_X N_a·∇_X N_b δ_ik``: a
+constant matrix (the pattern's Laplacian in each coordinate), positive definite with the supports
+held. The film is in the tangent only, never in the energy or the residual: the iteration
+converges to an equilibrium of the law itself (a stress-free structure stays on its design), and
+near a taut solution the tangent is exact to ``ε``, so Newton's method keeps converging at its
+quadratic rate until the residual is far below any tolerance.
 """
 
 from __future__ import annotations
@@ -111,7 +111,8 @@ class ErectionProblem:
     wrinkling
         Use the tension-field energy (no compression); else the law as it is.
     regularisation
-        ``ε``: the fictitious isotropic tension, relative to the law's stiffness.
+        ``ε``: the tension of the film that stabilises the tangent, relative to the law's
+        stiffness (module docs).
     cables
         Edge cables, or None.
     pressure
@@ -146,16 +147,22 @@ class ErectionProblem:
         self.connectivity = Connectivity(len(self.design_points), cells)
         self.reference_area = float(sum(b.reference.weights.sum() for b in blocks)) / thickness
         self._wrinkles: dict[int, np.ndarray] = {}  # per block: the wrinkles last found
+        self._film = [self._film_hessian(b) for b in blocks] if self.tension > 0 else None
+
+    def _film_hessian(self, block: MembraneBlock) -> np.ndarray:
+        """The film's Hessian ``(m, nen, 3, nen, 3)``: the same for every ``x``."""
+        points = block.reference.weights.shape
+        unit = np.broadcast_to(self.tension * np.eye(6), (*points, 6, 6))
+        return forward_projected_hessian(block.reference, np.ascontiguousarray(unit))
 
     # ------------------------------------------------------------------ the energy
     def response(
         self, fibres: Fibres | None, relaxed: bool | None = None, block: int | None = None
     ):
         """The response function of :func:`vares.mechanics.forward.forward_block`: the relaxed
-        (or plain) law and the regularising tension. With ``block``, the wrinkles found at the
-        block's last evaluation are the start of the next (Newton's iterates move little)."""
+        (or plain) law. With ``block``, the wrinkles found at the block's last evaluation are
+        the start of the next (Newton's iterates move little)."""
         relaxed = self.wrinkling if relaxed is None else relaxed
-        tension = self.tension
 
         def respond(C, tangent):
             if relaxed and np.isrealobj(C):
@@ -167,23 +174,27 @@ class ErectionProblem:
                     self._wrinkles[block] = r.wrinkle
             else:
                 r = self.material.response(C, fibres, tangent=tangent)
-            psi = r.psi + 0.5 * tension * (C[..., 0, 0] + C[..., 1, 1] - 2.0)
-            return psi, r.stress + tension * np.eye(2), r.tangent
+            return r.psi, r.stress, r.tangent
 
         return respond
 
-    def evaluate(self, x: np.ndarray, order: int = 2) -> ErectionEvaluation:
+    def evaluate(
+        self, x: np.ndarray, order: int = 2, relaxed: bool | None = None
+    ) -> ErectionEvaluation:
         """Energy (and per-block gradients for ``order ≥ 1``, Hessians for ``order = 2``) at the
-        positions ``x`` ``(n, 3)``."""
+        positions ``x`` ``(n, 3)``; ``relaxed``: the tension-field or the plain law (default
+        :attr:`wrinkling`)."""
         energies, gradients, hessians, jacobian_hessians = [], [], [], []
         total = 0.0
         for index, block in enumerate(self.blocks):
             nodes = x[block.cells]
-            respond = self.response(block.fibres, block=index)
+            respond = self.response(block.fibres, relaxed, block=index)
             result = forward_block(block.reference, nodes, respond, order)
             energies.append(result.energy)
             total += np.sum(result.energy).real
             gradient, hessian = result.gradient, result.hessian
+            if hessian is not None and self._film is not None:
+                hessian = hessian + self._film[index]
             if self.pressure:
                 load = pressure_terms(nodes, self.pressure, order)
                 total += np.sum(load[0]).real
@@ -212,12 +223,15 @@ class ErectionProblem:
         )
 
     def projected_hessians(self, evaluation: ErectionEvaluation) -> list[np.ndarray]:
-        """The membrane Hessians made positive semi-definite point by point and the cables'
-        (positive semi-definite already); the pressure's load stiffness is left out."""
+        """The membrane Hessians made positive semi-definite point by point (with the film's,
+        module docs) and the cables' (positive semi-definite already); the pressure's load
+        stiffness is left out."""
         out = [
             forward_projected_hessian(b.reference, h)
             for b, h in zip(self.blocks, evaluation.jacobian_hessians, strict=True)
         ]
+        if self._film is not None:
+            out = [h + film for h, film in zip(out, self._film, strict=True)]
         if evaluation.cable_hessian is not None:
             out.append(evaluation.cable_hessian)
         return out

@@ -103,6 +103,11 @@ class NewtonContext:
     #: The node a pattern free to turn (``orientation="free"``) turns about in a line search's
     #: steps (:class:`_Path`); ``None``: steps are straight lines.
     turning_about: int | None = None
+    #: Give up a line-search iteration whose least residual has not halved over this many
+    #: iterations (``None``: never), so the next attempt goes on from there: an energy with
+    #: kinks can keep Newton's steps circling the solution (cells switching state at every
+    #: iteration) where damped steps settle it.
+    stall_window: int | None = None
 
     def __post_init__(self) -> None:
         #: the linear solver, reusing its factorisations where that is cheaper (inexact Newton)
@@ -253,6 +258,11 @@ def newton(
             return x
         if iteration == ctx.max_iterations:
             raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
+        if method == "line-search" and _stalled(residuals, ctx.stall_window):
+            raise Failure(
+                f"the residual stalled at {residuals[-1]:.3g} over {ctx.stall_window} iterations",
+                x,
+            )
         eta = forcing_term(
             residuals, ctx.residual_tolerance / ctx.force_scale, ctx.loosest_forcing
         )  # relative residuals: the same ratios
@@ -281,6 +291,13 @@ def newton(
                     folding=True,
                 )
     raise AssertionError("unreachable")
+
+
+def _stalled(residuals: list[float], window: int | None) -> bool:
+    """Whether the least of the last ``window`` residuals is above half the least before."""
+    if window is None or len(residuals) <= window:
+        return False
+    return min(residuals[-window:]) > 0.5 * min(residuals[:-window])
 
 
 def _full_step(problem, x, ctx, matrix, residual_vector, eta):
