@@ -197,7 +197,7 @@ def read_biaxial(path: str | Path, *, name: str | None = None) -> BiaxialRecord:
         if below is not None:
             cells = lines[below - 1].strip().split(delimiter)
             if len(cells) >= len(header_cells) and all(
-                _unit(cells[i]) in FORCE_UNITS | STRAIN_UNITS | TIME_UNITS | {""}
+                _unit(cells[i]) in {*FORCE_UNITS, *STRAIN_UNITS, *TIME_UNITS, ""}
                 for i in roles
                 if roles[i] != "stage"
             ):
