@@ -1,5 +1,6 @@
 """What a pattern does: per-cell results of any pattern, the compensation report, statistics,
-and the erection analysis (the structure built from its patterns)."""
+the erection analysis (the structure built from its patterns), and the producibility of a
+draped ply."""
 
 from typing import TYPE_CHECKING
 
@@ -13,6 +14,7 @@ if TYPE_CHECKING:
     from .erection_model import Pattern
     from .evaluate import PatternEvaluation, evaluate
     from .options import ErectionOptions
+    from .producibility import Producibility, producibility
     from .statistics import field_statistics
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, __file__)

@@ -1,5 +1,5 @@
 """The fixed 3D shape: surface meshes, reference elements, flattenings (initial guesses), the
-erected warp direction, and the shipped example surfaces."""
+erected warp direction, the kinematic drape of a ply, and the shipped example surfaces."""
 
 from typing import TYPE_CHECKING
 
@@ -7,6 +7,8 @@ from .._lazy import lazy_exports
 
 if TYPE_CHECKING:
     from . import examples
+    from .drape import KinematicDrape, kinematic_drape
+    from .drape_net import KinematicNet, kinematic_net
     from .elements import ELEMENTS, ReferenceElement
     from .flatten import ProjectionPlane, lscm, projection_distortion, projection_plane, signed_area
     from .mesh import MeshError, SurfaceMesh

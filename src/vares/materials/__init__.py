@@ -9,6 +9,7 @@ from .base import (
     MaterialError,
     MaterialResponse,
 )
+from .forming import FABRIC_KINDS, FabricKind, locking_angle
 from .isotropic import IncompressibleNeoHooke, NeoHooke, StVenantKirchhoff
 from .presets import FabricPreset, fabric, load_presets, presets
 
@@ -43,8 +44,10 @@ def make_material(law: str, parameters: dict[str, object]) -> Hyperelastic:
 
 
 __all__ = [
+    "FABRIC_KINDS",
     "INVARIANTS",
     "LAWS",
+    "FabricKind",
     "FabricPreset",
     "Fibres",
     "Hyperelastic",
@@ -58,6 +61,7 @@ __all__ = [
     "StVenantKirchhoff",
     "fabric",
     "load_presets",
+    "locking_angle",
     "make_material",
     "presets",
 ]
