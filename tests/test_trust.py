@@ -9,7 +9,7 @@ from conftest import error_line, run
 import vares
 from vares.geometry.examples import hypar, ruffled_fan
 from vares.geometry.flatten import inverted_cells, lscm, tutte, untangle
-from vares.geometry.injectivity import pattern_overlap
+from vares.geometry.injectivity import pattern_area_misfit, pattern_overlap
 from vares.io.meshes import write_surface
 
 NEO_HOOKE = vares.materials.NeoHooke(1000.0, 0.3)
@@ -101,6 +101,62 @@ def test_a_pattern_that_overlaps_itself_is_not_converged_nor_cut(tmp_path):
     assert (out / "pattern.svg").exists() and not (out / "pattern.dxf").exists()
     cli = run("pattern", source, "-o", out, "-q", "--force", "--allow-overlap")
     assert cli.exit_code == 1 and (out / "pattern.dxf").exists()
+
+
+def _sphere_less_one_triangle(n: int = 200) -> vares.SurfaceMesh:
+    """A unit sphere of ``n`` nodes (a Fibonacci lattice, its convex hull) with one triangle
+    taken out: a surface open at one small hole."""
+    from scipy.spatial import ConvexHull
+
+    k = np.arange(n) + 0.5
+    z = 1 - 2 * k / n
+    phi = np.pi * (1 + 5**0.5) * k
+    points = np.column_stack([np.sqrt(1 - z**2) * np.cos(phi), np.sqrt(1 - z**2) * np.sin(phi), z])
+    triangles = ConvexHull(points).simplices
+    a, b, c = (points[triangles[:, i]] for i in range(3))
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c) < 0
+    triangles[inward] = triangles[inward][:, ::-1]
+    return vares.SurfaceMesh(points, {"triangle": triangles[1:]})
+
+
+def test_a_pattern_far_smaller_than_its_surface_is_not_converged_nor_cut(tmp_path):
+    mesh = _sphere_less_one_triangle()
+    with pytest.warns(UserWarning, match="conformal map folds"):
+        result = vares.solve(mesh, NEO_HOOKE)
+    assert not result.converged and result.overlap is None and result.uncuttable
+    misfit = result.area_misfit
+    assert misfit.ratio == pytest.approx(result.pattern_area / result.surface_area, rel=1e-12)
+    assert misfit.ratio < 0.1  # a small cloth stretched over the whole sphere
+    assert misfit.stretch_max == pytest.approx(result.fields["det_F"].max(), rel=1e-9)
+    assert "the pattern's area is" in result.reason and "cut it into panels" in result.reason
+    source = tmp_path / "ball.obj"
+    write_surface(source, mesh)
+    out = tmp_path / "out"
+    cli = run("pattern", source, "-o", out, "-q")
+    assert cli.exit_code == 1
+    line = error_line(cli)
+    assert f"the pattern's area is {100 * misfit.ratio:.3g} % of the surface's" in line
+    assert "(is it nearly closed?)" in line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] is False and "the pattern's area is" in summary["reason"]
+    assert (out / "pattern.svg").exists() and not (out / "pattern.dxf").exists()
+    cli = run("pattern", source, "-o", out, "-q", "--force", "--allow-overlap")
+    assert cli.exit_code == 1 and (out / "pattern.dxf").exists()
+
+
+@pytest.mark.parametrize(
+    ("ratio", "refused"), [(0.6, True), (0.7, False), (1.4, False), (1.6, True)]
+)
+def test_the_area_a_pattern_may_have_is_within_a_factor_of_one_and_a_half(ratio, refused):
+    mesh = hypar(n=6, rise=0.0)  # a flat square: its pattern scaled by √ratio has ratio × its area
+    misfit = pattern_area_misfit(mesh, mesh.points[:, :2] * np.sqrt(ratio))
+    assert (misfit is not None) == refused
+    if refused:
+        assert misfit.ratio == pytest.approx(ratio, rel=1e-12)
+        assert misfit.stretch_min == pytest.approx(1 / ratio, rel=1e-12)
+        assert misfit.stretch_max == pytest.approx(1 / ratio, rel=1e-12)
+        assert ("stretched to" in misfit.describe()) == (ratio < 1)
+        assert f"{100 * ratio:.3g} % of the surface's" in misfit.describe()
 
 
 def test_an_initial_pattern_file_from_the_command_line_and_a_job(tmp_path):

@@ -154,7 +154,7 @@ def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | No
     job, result = outcome.job, panel.result
     if job.input.example is not None or job.structure is not None:
         _write(panel, "surface.obj", lambda p: write_surface(p, panel.mesh, units=panel.units))
-    if result.converged or result.overlap is not None:
+    if result.converged or result.uncuttable:
         dxf = result.converged or job.output.allow_overlap
         cut = None  # a strip of a cut job: its cut line with the allowance of every edge
         if outcome.cut is not None:
@@ -297,7 +297,7 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
     """``structure.json`` and (when it converged) ``structure.dxf``; paths to ``outcome.files``."""
     job, structure = outcome.job, outcome.structure
     directory = outcome.directory
-    # marks exist when every panel converged or failed only by overlapping itself; a cut job's
+    # marks exist when every panel converged or ended in no cutting pattern; a cut job's
     # pieces are drawn on the roll instead
     drawn = structure.converged or (job.output.allow_overlap and marks is not None)
     if drawn and job.cut is None:

@@ -98,7 +98,7 @@ def _key_figures(outcome: PanelOutcome, unit_names: dict[str, str]) -> list[str]
         ("time", _time(result)),
     ]
     parts = ["<h2>Key figures</h2>", table(key, ident="key-figures")]
-    if not (result.converged or result.overlap is not None):
+    if not (result.converged or result.uncuttable):
         return parts
     stats = field_statistics(result.fields)
     rows = []
@@ -227,7 +227,7 @@ def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
     parts += _material_section(result, job, material)
     parts += _key_figures(panel, units_of(outcome))
     parts += _convergence_section(result)
-    if result.converged or result.overlap is not None:
+    if result.converged or result.uncuttable:
         parts += _pattern_figures(panel, material)
     if outcome.erection is not None and outcome.structure is None:
         parts += erection_section(outcome.erection, outcome.units, outcome.directory / "erect")

@@ -134,7 +134,7 @@ def _write(outcome: JobOutcome, root: Path, save_job: Path | None, folder: Outpu
         panel.warnings = outcome.warnings + panel.warnings
     marks = None
     if outcome.structure is not None and all(
-        p.result.converged or p.result.overlap is not None for p in outcome.panels
+        p.result.converged or p.result.uncuttable for p in outcome.panels
     ):
         marks = structure_marks(outcome)
     for index, panel in enumerate(outcome.panels):

@@ -297,8 +297,8 @@ class OutputOptions(Options):
     allow_overlap: bool = option(
         False,
         "bool",
-        "Write the DXF even of a pattern that overlaps itself (it is then no cut file: the "
-        "crossings are circled in the drawings).",
+        "Write the DXF even of a pattern that overlaps itself or whose area is far from the "
+        "surface's (it is then no cut file: the crossings are circled in the drawings).",
         section="output",
         flags=("--allow-overlap",),
     )

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry.flatten import tutte
-from ..geometry.injectivity import Overlap, pattern_overlap
+from ..geometry.injectivity import AreaMisfit, Overlap, pattern_area_misfit, pattern_overlap
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic
 from ..mechanics.assembly import Assembler
@@ -77,7 +77,9 @@ def solve(
     -------
     PatternResult
         Always returned; ``converged`` and ``reason`` tell whether and why not. A pattern that
-        overlaps itself (its outline crosses itself) is not converged: ``overlap`` says where.
+        overlaps itself (its outline crosses itself) is not converged: ``overlap`` says where;
+        nor is one whose area is not within a factor 1.5 of the surface's (no fabric can be
+        erected from it): ``area_misfit`` says by how much.
     """
     given = settings.pop("initial_guess", None)
     if given is not None and isinstance(given, str):
@@ -150,6 +152,7 @@ def _solve(mesh, material, thickness, prestress, options, callback, given) -> Pa
         warp_direction=None if options.warp_direction is None else np.array(options.warp_direction),
         warp_deviation=attempt.deviation,
         overlap=attempt.overlap,
+        area_misfit=attempt.area_misfit,
     )
 
 
@@ -165,6 +168,7 @@ class _Attempt:
     reason: str | None
     deviation: float | None
     overlap: Overlap | None
+    area_misfit: AreaMisfit | None = None
 
     @property
     def energy(self) -> float:
@@ -227,7 +231,10 @@ class _Run:
         overlap = None if reason is not None else pattern_overlap(self.mesh, x)
         if overlap is not None:
             reason = overlap.describe(self.mesh)
-        return _Attempt(start, x, problem, fibres, rotation, reason, deviation, overlap)
+        misfit = None if reason is not None else pattern_area_misfit(self.mesh, x)
+        if misfit is not None:
+            reason = misfit.describe()
+        return _Attempt(start, x, problem, fibres, rotation, reason, deviation, overlap, misfit)
 
     def _context(self, problem: Problem, start: Start, rotation: str) -> NewtonContext:
         free, constraint = rigid_modes(start.coordinates, rotation)

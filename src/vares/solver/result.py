@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.flatten import ProjectionPlane, signed_area
-from ..geometry.injectivity import Overlap
+from ..geometry.injectivity import AreaMisfit, Overlap
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic
 from ..mechanics.fields import cell_fields
@@ -88,6 +88,10 @@ class PatternResult:
     overlap
         Where the pattern overlaps itself (:class:`vares.geometry.injectivity.Overlap`), when
         it does: such a pattern is not converged (it cannot be cut in one piece).
+    area_misfit
+        How far the pattern's area is from the surface's
+        (:class:`vares.geometry.injectivity.AreaMisfit`), when it is not within a factor 1.5
+        of it: such a pattern is not converged either (no fabric can be erected from it).
     linear_solver, elapsed
         The sparse solver used and the wall time of the solve (seconds).
     warm_up
@@ -116,6 +120,7 @@ class PatternResult:
     warp_direction: np.ndarray | None = None
     warp_deviation: float | None = None
     overlap: Overlap | None = None
+    area_misfit: AreaMisfit | None = None
     warm_up: float = 0.0
     _fields: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
@@ -133,6 +138,12 @@ class PatternResult:
     def cg_iterations(self) -> int:
         """Conjugate-gradient iterations (preconditioned by an earlier factorisation)."""
         return sum(r.cg_iterations for r in self.history)
+
+    @property
+    def uncuttable(self) -> bool:
+        """The solve found a pattern that is no cutting pattern: it overlaps itself, or its
+        area is far from the surface's. Its files are written, its DXF only when asked for."""
+        return self.overlap is not None or self.area_misfit is not None
 
     @property
     def surface_area(self) -> float:

@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..geometry.injectivity import pattern_overlap
+from ..geometry.injectivity import pattern_area_misfit, pattern_overlap
 from ..materials import Hyperelastic
 from ..mechanics.assembly import Assembler
 from ..mechanics.problem import Problem
@@ -230,9 +230,12 @@ def _match(
     ):
         # a matched pattern is checked again: it must still be cuttable in one piece
         overlap = pattern_overlap(result.mesh, x) if converged else None
+        misfit = pattern_area_misfit(result.mesh, x) if converged and overlap is None else None
         own_reason = reason if not converged else None
         if overlap is not None:
             own_reason = overlap.describe(result.mesh)
+        if misfit is not None:
+            own_reason = misfit.describe()
         matched = replace(
             result,
             material_coordinates=x,
@@ -240,10 +243,11 @@ def _match(
             converged=own_reason is None,
             reason=own_reason,
             overlap=overlap,
+            area_misfit=misfit,
             _fields=None,
         )
         results.append(matched)
-        if overlap is not None and reason is None:
+        if (overlap is not None or misfit is not None) and reason is None:
             reason = f"panel {panel.name}: {own_reason}"
     converged = reason is None
     return replace(
