@@ -9,6 +9,7 @@ from conftest import error_line, run
 
 import vares
 from vares.analysis import compensation_report
+from vares.analysis.checks import pattern_warnings
 from vares.geometry.examples import grid_cells
 from vares.io.biaxial import BiaxialFileError, read_biaxial, write_biaxial
 from vares.materials import MaterialError, OrthotropicStVenantKirchhoff, fabric
@@ -169,6 +170,11 @@ def test_a_pattern_compensated_by_the_measured_values():
     )
     with pytest.raises(MaterialError, match="positive strains"):
         compensating_law(-0.001, fill, prestress, 0.35, 30.0)
+    # the law holds the measured values at their prestress only: elsewhere a pattern is warned
+    assert not any("measured at" in w for w in pattern_warnings(result, None))
+    other = vares.solve(mesh, law, prestress=(3.0, 2.0), warp_direction=(1, 0, 0))
+    (note,) = [w for w in pattern_warnings(other, None) if "measured at" in w]
+    assert "measured at the prestress 2/1.5; this pattern's is 3/2" in note
 
 
 # ---- reading files -------------------------------------------------------------------------

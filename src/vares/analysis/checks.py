@@ -12,13 +12,16 @@ prestress the warnings are measured against it, so that round-off is not flagged
 - the misfit (achieved minus intended yarn force) beyond the intended prestress itself:
   compensation alone cannot hold the design shape there;
 - slack yarns, where the achieved force falls below the slack threshold by more than
-  :data:`RELATIVE_COMPRESSION` × the prestress.
+  :data:`RELATIVE_COMPRESSION` × the prestress;
+- a fabric compensated by measured values (``compensate_by = "measured"``) under a prestress
+  other than the one they were measured at.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..materials.fitting import MeasuredCompensationLaw
 from ..solver.result import PatternResult
 from .compensation import CompensationReport
 
@@ -33,7 +36,8 @@ AREA_SHARE = 0.01
 def pattern_warnings(result: PatternResult, report: CompensationReport | None) -> list[str]:
     """One sentence per concern: not converged; stopped at the round-off floor above the
     tolerance; compression (wrinkling risk); misfit beyond the prestress; slack yarns; large
-    area distortion; the warp off its prescribed direction."""
+    area distortion; the warp off its prescribed direction; measured compensation values used
+    at another prestress."""
     if not result.converged:
         return [f"the solve did not converge: {result.reason}"]
     notes = []
@@ -63,7 +67,29 @@ def pattern_warnings(result: PatternResult, report: CompensationReport | None) -
         notes.append(f"large area distortion: det F from {det_f.min():.3f} to {det_f.max():.3f}")
     if result.warp_deviation is not None and abs(result.warp_deviation) > 0.1:
         notes.append(f"mean warp deviation {result.warp_deviation:.3g}° from the direction")
+    notes += _measured_at(result, target)
     return notes
+
+
+def _measured_at(result: PatternResult, target: np.ndarray | None) -> list[str]:
+    """A law through measured compensation values holds them at the prestress they were
+    measured at only (docs/fabrics.md)."""
+    if not isinstance(result.material, MeasuredCompensationLaw):
+        return []
+    warp, fill = result.material.measured_at
+    if target is None:
+        return [
+            f"the fabric's compensation values were measured at the prestress {warp:g}/{fill:g}, "
+            "but this pattern has no prestress: it is not compensated"
+        ]
+    mean = target.mean(axis=0)
+    if np.allclose(mean, (warp, fill), rtol=0.05):
+        return []
+    return [
+        f"the fabric's compensation values were measured at the prestress {warp:g}/{fill:g}; "
+        f"this pattern's is {mean[0]:.3g}/{mean[1]:.3g} on average: its compensation is the "
+        "secant law's, not measured"
+    ]
 
 
 def _target(result: PatternResult, cells: int) -> np.ndarray | None:

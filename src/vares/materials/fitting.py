@@ -47,6 +47,7 @@ __all__ = [
     "CompensationValues",
     "ElasticFit",
     "FabricFit",
+    "MeasuredCompensationLaw",
     "NotInRecord",
     "RatioResidual",
     "Summary",
@@ -464,13 +465,30 @@ def law_compensation(
     return float(stretch[0] - 1.0), float(stretch[1] - 1.0)
 
 
+class MeasuredCompensationLaw(OrthotropicStVenantKirchhoff):
+    """The orthotropic law through measured compensation values (:func:`compensating_law`):
+    an :class:`~vares.materials.OrthotropicStVenantKirchhoff` that also knows the prestress
+    ``measured_at`` (warp, fill; kN/m) it was calibrated at, so that a pattern under another
+    prestress can be warned about (:func:`vares.analysis.checks.pattern_warnings`)."""
+
+    def __init__(
+        self, E1: float, E2: float, G12: float, nu12: float, measured_at: tuple[float, float]
+    ) -> None:
+        super().__init__(E1, E2, G12, nu12)
+        self.measured_at = (float(measured_at[0]), float(measured_at[1]))
+
+    @property
+    def parameters(self) -> dict[str, object]:
+        return super().parameters | {"measured_at": list(self.measured_at)}
+
+
 def compensating_law(
     warp: float,
     fill: float,
     prestress: tuple[float, float],
     nu12: float,
     G12: float,
-) -> OrthotropicStVenantKirchhoff:
+) -> MeasuredCompensationLaw:
     """The orthotropic law whose VaReS pattern of a flat panel under ``prestress`` (kN/m) is
     compensated by exactly the measured strains ``warp`` and ``fill`` (mm/mm).
 
@@ -508,7 +526,7 @@ def compensating_law(
             f"no positive-definite orthotropic law with nu12 = {nu:g} is compensated by warp "
             f"{warp:.4%} and fill {fill:.4%} at the prestress {p1:g}/{p2:g}"
         )
-    return OrthotropicStVenantKirchhoff(float(E1), float(E2), float(G12), nu)
+    return MeasuredCompensationLaw(float(E1), float(E2), float(G12), nu, (p1, p2))
 
 
 @dataclass(frozen=True)
