@@ -179,11 +179,13 @@ def check_stl(path: Path) -> None:
     triangles): a binary STL is ``84 + 50·n`` bytes for the ``n`` triangles its header
     announces; an ASCII STL begins with ``solid`` and has only its keywords' lines (``facet``,
     ``outer loop``, ``vertex``, ``endloop``, ``endfacet``, ``endsolid``)."""
-    data = Path(path).read_bytes()
-    size = len(data)
-    announced = int.from_bytes(data[80:84], "little") if size >= 84 else None
+    size = Path(path).stat().st_size
+    with open(path, "rb") as file:
+        header = file.read(84)
+    announced = int.from_bytes(header[80:84], "little") if size >= 84 else None
     if announced is not None and size == 84 + 50 * announced:
         return  # binary
+    data = Path(path).read_bytes()
     binary = b"\x00" in data[:4096]
     if not data.lstrip()[:5].lower() == b"solid" or binary:
         if binary and announced is not None:
