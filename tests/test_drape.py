@@ -5,9 +5,12 @@ a cylinder, and on a sphere the net computed here on the exact sphere (three sph
 in closed form) together with the Chebyshev-net relation ``γ = f(K u v)``, ``z f'' + f' = cos f``.
 """
 
+import json
+
+import meshio
 import numpy as np
 import pytest
-from conftest import rotation
+from conftest import error_line, rotation, run
 from scipy.integrate import solve_ivp
 from scipy.spatial import Delaunay
 
@@ -358,3 +361,36 @@ def test_fabric_kinds_carry_labelled_locking_angles():
         assert kind.source.strip()
     with pytest.raises(MaterialError, match="unknown fabric kind"):
         locking_angle("denim")
+
+
+# ---------------------------------------------------------------------------- command line
+
+
+def test_drape_command_writes_the_producibility(tmp_path):
+    from vares.app.cli.drape import FABRIC_KIND_NAMES
+    from vares.io.meshes import write_surface
+
+    assert FABRIC_KIND_NAMES == tuple(FABRIC_KINDS)
+    mesh = spherical_cap(R, 90.0, 20)
+    surface = tmp_path / "hemisphere.obj"
+    write_surface(surface, mesh)
+    out = tmp_path / "out"
+    args = ["drape", surface, "--seed", 0, 0, R, "--warp", 1, 0, 0, "--spacing", 3, "-o", out]
+    result = run(*args, "--fabric-kind", "woven-plain")
+    assert result.exit_code == 0, result.stderr
+    assert "producibility (locking 40°, warn from 32°)" in result.stderr
+    data = json.loads((out / "drape.json").read_text())
+    direct = kinematic_drape(mesh, [0, 0, R], [1, 0, 0], 3.0)
+    expected = producibility(direct.shear_angle, mesh.cell_areas(), 40.0)
+    assert data["producibility"]["limit_fraction"] == pytest.approx(expected.fractions["limit"])
+    assert data["producibility"]["limit_fraction"] > 0.01
+    written = meshio.read(out / "drape.vtu")
+    assert np.allclose(written.cell_data["shear_angle"][0], direct.shear_angle, equal_nan=True)
+    assert written.cell_data["warp"][0].shape == (mesh.num_cells, 3)
+    again = run(*args, "--locking-angle", "60")
+    assert again.exit_code == 2 and "exist" in error_line(again)
+    again = run(*args, "--locking-angle", "60", "--force", "-q")
+    assert again.exit_code == 0
+    assert json.loads((out / "drape.json").read_text())["producibility"]["limit_fraction"] == 0.0
+    off = run("drape", surface, "--seed", 0, 0, 3 * R, "-o", tmp_path / "off")
+    assert off.exit_code == 2 and "not on the mould" in error_line(off)

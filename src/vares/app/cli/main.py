@@ -6,6 +6,7 @@ import typer
 
 from .batch import batch
 from .cut import cut
+from .drape import drape
 from .erect import erect
 from .evaluate import evaluate
 from .fabric import fabric_app
@@ -22,7 +23,7 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch):
+for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch, drape):
     app.command()(command)
 app.add_typer(fabric_app, name="fabric")
 
