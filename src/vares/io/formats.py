@@ -187,7 +187,7 @@ def check_stl(path: Path) -> None:
         return  # binary
     data = Path(path).read_bytes()
     binary = b"\x00" in data[:4096]
-    if not data.lstrip()[:5].lower() == b"solid" or binary:
+    if data.removeprefix(b"\xef\xbb\xbf").lstrip()[:5].lower() != b"solid" or binary:
         if binary and announced is not None:
             raise MeshError(
                 f"{path} is not an STL file: a binary STL of the {announced} triangles its "
