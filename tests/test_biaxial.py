@@ -203,6 +203,9 @@ def test_reader_semicolons_decimal_commas_bom_n_per_5cm_and_percent(tmp_path):
         record.strain, [[0, 0], [0.015, 0.008], [0.03, 0.016], [0.0225, 0.012]]
     )
     np.testing.assert_array_equal(record.stage, [1, 1, 1, 2])
+    # integers first, decimal commas later: still decimal commas
+    path.write_text(DE_LAB.replace("0,0;1;0,00;0,00;0,0000;0,0000", "0;1;0;0;0;0"), "utf-8")
+    np.testing.assert_allclose(read_biaxial(path).force[1:, 0], [2.0, 4.0, 3.01])
 
 
 def test_reader_tabs_units_line_and_permille(tmp_path):
@@ -235,7 +238,12 @@ def test_reader_tabs_units_line_and_permille(tmp_path):
             ("[N/5cm];Kraft Schuss", "[kg];Kraft Schuss"),
             "line 4, column 3 (warp force): unknown unit 'kg'",
         ),
-        (("Dehnung Schuss [%]", "Temperatur [C]"), "no header line naming"),
+        (("Dehnung Schuss [%]", "Temperatur [C]"), "line 4: the header names no fill strain"),
+        (
+            ("Zeit [s];Stufe;Kraft Kette", "Probe;Stufe;Gewicht"),
+            "the header names no time "
+            "and no warp force column (it has: fill force, warp strain, fill strain)",
+        ),
         (("37,5;2", "20,0;2"), "line 8, column 1 (time): time does not increase"),
     ],
 )

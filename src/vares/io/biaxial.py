@@ -125,7 +125,7 @@ def _role(name: str) -> str | None:
         return f"{direction} strain"
     if has("force") and direction:
         return f"{direction} force"
-    if has("time") and not direction:
+    if (has("time") or "t" in tokens) and not direction:
         return "time"
     if has("stage") and not direction:
         return "stage"
@@ -162,6 +162,7 @@ def read_biaxial(path: str | Path, *, name: str | None = None) -> BiaxialRecord:
     lines = _read_text(path).splitlines()
     metadata: dict[str, str] = {}
     header_at, roles, delimiter = None, {}, None
+    best: tuple[int, int, set[str]] = (0, 0, set())  # the line naming most columns, for errors
     for number, raw in enumerate(lines, start=1):
         text = raw.strip().lstrip("\ufeff")
         if not text:
@@ -179,7 +180,18 @@ def read_biaxial(path: str | Path, *, name: str | None = None) -> BiaxialRecord:
         if set(_COLUMNS) <= set(found.values()):
             header_at, roles, header_cells = number, found, cells
             break
+        named = set(found.values()) & set(_COLUMNS)
+        if len(named) > best[1]:
+            best = (number, len(named), named)
         _meta(text, metadata, delimiter)
+    if header_at is None and best[1] >= 2:
+        lacking = [c for c in _COLUMNS if c not in best[2]]
+        _fail(
+            path,
+            best[0],
+            f"the header names no {' and no '.join(lacking)} column (it has: "
+            f"{', '.join(c for c in _COLUMNS if c in best[2])})",
+        )
     if header_at is None:
         raise BiaxialFileError(
             f"{path}: no header line naming the time, warp force, fill force, warp strain and "
@@ -221,7 +233,7 @@ def read_biaxial(path: str | Path, *, name: str | None = None) -> BiaxialRecord:
     width = len(header_cells)
     rows: list[list[float]] = []
     stage_text: list[str] = []
-    decimal_comma = None
+    decimal_comma = delimiter != ","  # with semicolons or tabs a comma can only be decimal
     for number in range(first_data + 1, len(lines) + 1):
         text = lines[number - 1].strip()
         if not text or text.startswith("#"):
@@ -231,8 +243,6 @@ def read_biaxial(path: str | Path, *, name: str | None = None) -> BiaxialRecord:
             cells.pop()
         if len(cells) != width:
             _fail(path, number, f"{len(cells)} fields, the header (line {header_at}) has {width}")
-        if decimal_comma is None and delimiter != ",":
-            decimal_comma = any(re.fullmatch(r"[-+]?\d*,\d+", c.strip()) for c in cells)
         row = []
         for role in _COLUMNS:
             i = column[role]
@@ -281,7 +291,7 @@ def _data_line(lines: list[str], first_data: int, index: int) -> int:
     return len(lines)
 
 
-def _number(cell: str, decimal_comma: bool | None, path: Path, line: int, column: int, name: str):
+def _number(cell: str, decimal_comma: bool, path: Path, line: int, column: int, name: str):
     text = cell.strip().strip('"').replace("\u202f", "").replace("\xa0", "")
     if decimal_comma:
         text = text.replace(",", ".")
