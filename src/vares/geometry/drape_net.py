@@ -190,7 +190,10 @@ def kinematic_net(
     on_axes = np.isfinite(positions[..., 0])
     faces[on_axes] = locator.locate(positions[on_axes])[0]
     faces[si, sj] = face
-    _march(positions, faces, (si, sj), spacing, tri_mesh.points[triangles], triangles)
+    corners = tri_mesh.points[triangles]
+    edge = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1).min()
+    steps = 64 + 8 * int(np.ceil(spacing / edge))  # a walk crosses about spacing / edge faces
+    _march(positions, faces, (si, sj), spacing, corners, triangles, steps)
     return KinematicNet(positions, faces, (si, sj), float(spacing))
 
 
@@ -236,7 +239,7 @@ def _given_generators(generators, seed, warp, fill) -> list[np.ndarray]:
     return halves
 
 
-def _march(positions, faces, seed, spacing, corners, triangles, max_steps: int = 200) -> None:
+def _march(positions, faces, seed, spacing, corners, triangles, max_steps: int) -> None:
     """Fill the nodes off the generator yarns in place, by anti-diagonals from the seed."""
     nu, nv = faces.shape
     a, b = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
