@@ -8,7 +8,7 @@ lies in, applied to that triangle's flat corners ``(u, v)``). Each net cell is s
 triangles along its diagonal from ``(i, j)`` to ``(i + 1, j + 1)``.
 
 Mesh nodes and cells outside the net (beyond its last row of cells, at the mould's edge or where a
-cell would have sheared past 90°) are **extrapolated** from the nearest net triangle (linearly for
+cell would have sheared to ±90°) are **extrapolated** from the nearest net triangle (linearly for
 the flat coordinates, as constants for the cell fields) when they lie within ``reach`` yarn
 spacings of a net node, and are NaN farther out; :attr:`KinematicDrape.node_in_net` and
 :attr:`KinematicDrape.cell_in_net` say which were interpolated.

@@ -43,7 +43,7 @@ class KinematicNet:
     """The nodes of a kinematic drape on a ``(nu, nv)`` grid (warp index first).
 
     ``positions`` ``(nu, nv, 3)``: the nodes on the mould, NaN where the net does not reach
-    (outside the mould, or beyond a cell that would shear past 90°); ``faces`` ``(nu, nv)``: the
+    (outside the mould, or beyond a cell that would shear to ±90°); ``faces`` ``(nu, nv)``: the
     triangle of the (triangulated) mould each node lies in, −1 where there is none; ``seed``: the
     grid index of the seed node; ``spacing``: the yarn spacing (length units of the mesh).
     """
@@ -280,7 +280,8 @@ def _sphere_intersections(p0, p1, p2, start, spacing, corners, normals, neighbou
     count = len(p1)
     chord = p2 - p1
     distance = np.linalg.norm(chord, axis=1)
-    e = chord / distance[:, None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        e = chord / distance[:, None]
     centre = 0.5 * (p1 + p2)
     radius_sq = spacing**2 - 0.25 * distance**2
     radius = np.sqrt(np.clip(radius_sq, 0.0, None))
@@ -292,7 +293,9 @@ def _sphere_intersections(p0, p1, p2, start, spacing, corners, normals, neighbou
     point = np.full((count, 3), np.nan)
     found = np.full(count, -1, dtype=np.int64)
     face, previous = start.copy(), np.full(count, -1, dtype=np.int64)
-    active = np.flatnonzero(radius_sq > 1e-12 * spacing**2)  # else the cell shears past 90°
+    # the rhombus (p0, p1, ·, p2) has the yarn angle 2 arcsin(distance / 2 spacing) at p0:
+    # distance → 0 or → 2 spacing is a cell sheared to ±90°, where the net ends
+    active = np.flatnonzero((radius_sq > 1e-12 * spacing**2) & (distance > 1e-6 * spacing))
     for _ in range(max_steps):
         if not active.size:
             break
