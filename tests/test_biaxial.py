@@ -373,3 +373,30 @@ def test_fabric_file_errors(tmp_path):
         fabric(str(path)).material("measured")
     result = run("example", "hypar", "-o", tmp_path / "o", "--compensate-by", "law")
     assert result.exit_code == 2 and "needs a fabric" in error_line(result)
+
+
+# ---- the scatter carried into a pattern -----------------------------------------------------
+def test_pattern_band_of_a_flat_panel_is_the_closed_form(tmp_path):
+    """A flat 3 × 2 panel, compensation 0.8 ± 0.02 % warp and 0.6 ± 0.03 % fill: the pattern's
+    length is 3/(1 + ε_w) at the mean and at the band's ends, its width 2/(1 + ε_f)."""
+    from vares.analysis.scatter import pattern_band
+
+    path = tmp_path / "f.toml"
+    path.write_text(
+        '[f]\nE1 = 800.0\nE2 = 600.0\nG12 = 30.0\nnu12 = 0.3\nsource = "test"\n\n'
+        "[f.compensation]\nprestress = [2.0, 1.5]\nwarp = 0.008\nfill = 0.006\n"
+        "warp_std = 0.0002\nfill_std = 0.0003\n",
+        encoding="utf-8",
+    )
+    x, y = np.meshgrid(np.linspace(0, 3.0, 7), np.linspace(0, 2.0, 5))
+    mesh = vares.SurfaceMesh(
+        np.column_stack([x.ravel(), y.ravel(), 0 * x.ravel()]), grid_cells(7, 5, "quad")
+    )
+    band = pattern_band(mesh, fabric(str(path)), warp_direction=(1, 0, 0))
+    assert band.mean["warp_length"] == pytest.approx(3.0 / 1.008, rel=1e-8)
+    assert band.low["warp_length"] == pytest.approx(3.0 / 1.0082, rel=1e-8)
+    assert band.high["warp_length"] == pytest.approx(3.0 / 1.0078, rel=1e-8)
+    assert band.low["fill_length"] == pytest.approx(2.0 / 1.0063, rel=1e-8)
+    assert band.high["boundary_length"] == pytest.approx(2 * (3 / 1.0078 + 2 / 1.0057), rel=1e-8)
+    corner = np.hypot(1.5 * (1 / 1.0078 - 1 / 1.008), 1.0 * (1 / 1.0057 - 1 / 1.006))
+    assert band.node_deviation == pytest.approx(corner, rel=1e-5)

@@ -1,0 +1,132 @@
+"""The scatter of a fabric's compensation values carried into a panel's pattern.
+
+The compensation values of a batch scatter from specimen to specimen (docs/fabrics.md). A
+pattern compensated by their mean is one of the patterns the batch allows; :func:`pattern_band`
+solves the panel again with the warp and fill values at their mean ± ``sigmas`` standard
+deviations (the four corners) and reports, for the pattern's length along the warp, its width
+along the fill, its boundary length and its area, the value of the mean pattern and the
+smallest and largest over the corners, and how far any node moves (after the best rigid fit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import product
+
+import numpy as np
+
+from ..geometry.mesh import SurfaceMesh
+from ..materials.base import MaterialError
+from ..materials.fitting import compensating_law
+from ..materials.presets import FabricPreset
+from ..solver.api import solve
+from ..solver.result import PatternResult
+
+__all__ = ["PatternBand", "pattern_band", "pattern_dimensions"]
+
+#: The dimensions a band gives (pattern units; area in units²).
+DIMENSIONS = ("warp_length", "fill_length", "boundary_length", "area")
+
+
+@dataclass(frozen=True)
+class PatternBand:
+    """A panel's pattern under the scatter of its compensation values.
+
+    ``mean``: the dimensions of the pattern from the mean values; ``low``, ``high``: the
+    smallest and largest over the corner cases ``cases`` (warp, fill strains);
+    ``node_deviation``: the largest distance of a node from its place in the mean pattern,
+    each corner pattern moved rigidly onto it (pattern units); ``sigmas``: the half-width of
+    the band in standard deviations.
+    """
+
+    mean: dict[str, float]
+    low: dict[str, float]
+    high: dict[str, float]
+    node_deviation: float
+    sigmas: float
+    cases: tuple[tuple[float, float], ...]
+    results: tuple[PatternResult, ...]
+
+    def rows(self) -> list[tuple[str, str, str]]:
+        """Text rows ``(dimension, mean, low … high)``."""
+        return [
+            (n.replace("_", " "), f"{self.mean[n]:.6g}", f"{self.low[n]:.6g} … {self.high[n]:.6g}")
+            for n in DIMENSIONS
+        ]
+
+
+def pattern_dimensions(result: PatternResult) -> dict[str, float]:
+    """Length along the warp, width along the fill (extents of the nodes projected on the
+    pattern's fibre directions), boundary length and area of a solved pattern."""
+    pattern = result.material_coordinates
+    fibres = result.fibres
+    warp = np.array([1.0, 0.0]) if fibres is None else fibres.warp
+    fill = np.array([0.0, 1.0]) if fibres is None else fibres.fill
+    edges = result.mesh.boundary_edges()
+    boundary = float(np.linalg.norm(pattern[edges[:, 1]] - pattern[edges[:, 0]], axis=1).sum())
+    return {
+        "warp_length": float(np.ptp(pattern @ warp)),
+        "fill_length": float(np.ptp(pattern @ fill)),
+        "boundary_length": boundary,
+        "area": float(result.fields["pattern_area"].sum()),
+    }
+
+
+def _aligned(reference: np.ndarray, moving: np.ndarray) -> np.ndarray:
+    """``moving`` after the proper 2D rigid motion that best fits it onto ``reference``."""
+    a, b = reference.mean(axis=0), moving.mean(axis=0)
+    u, _, vt = np.linalg.svd((moving - b).T @ (reference - a))
+    d = np.sign(np.linalg.det(u @ vt))
+    return (moving - b) @ (u @ np.diag([1.0, d]) @ vt) + a
+
+
+def pattern_band(
+    mesh: SurfaceMesh,
+    fabric: FabricPreset,
+    prestress: tuple[float, float] | None = None,
+    *,
+    sigmas: float = 1.0,
+    thickness: float = 1.0,
+    **settings,
+) -> PatternBand:
+    """Solve ``mesh`` with ``fabric`` compensated by its measured values at the mean and at
+    the four corners mean ± ``sigmas`` standard deviations of warp and fill.
+
+    ``prestress`` defaults to the one the values were measured at; ``settings`` go to
+    :func:`vares.solve` (``warp_direction``, ``orientation``, …). Raises
+    :class:`MaterialError` for a fabric without measured compensation values.
+    """
+    c = fabric.compensation
+    if c is None:
+        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    if not (np.isfinite(sigmas) and sigmas >= 0):
+        raise ValueError(f"sigmas must be a number ≥ 0; got {sigmas!r}")
+    load = c.prestress if prestress is None else prestress
+    mean_law = compensating_law(c.warp, c.fill, c.prestress, fabric.nu12, fabric.G12)
+    centre = solve(mesh, mean_law, thickness, prestress=load, **settings)
+    if not centre.converged:
+        raise MaterialError(f"the pattern from the mean values did not converge: {centre.reason}")
+    cases, results = [], []
+    for sw, sf in product((-1.0, 1.0), repeat=2):
+        warp, fill = c.warp + sw * sigmas * c.warp_std, c.fill + sf * sigmas * c.fill_std
+        law = compensating_law(warp, fill, c.prestress, fabric.nu12, fabric.G12)
+        results.append(solve(mesh, law, thickness, prestress=load, **settings))
+        cases.append((warp, fill))
+    failed = [case for case, r in zip(cases, results, strict=True) if not r.converged]
+    if failed:
+        raise MaterialError(f"the pattern did not converge for the compensation values {failed}")
+    dims = [pattern_dimensions(r) for r in results]
+    reference = centre.material_coordinates
+    deviation = max(
+        float(np.linalg.norm(_aligned(reference, r.material_coordinates) - reference, axis=1).max())
+        for r in results
+    )
+    return PatternBand(
+        mean=pattern_dimensions(centre),
+        low={n: min(d[n] for d in dims) for n in DIMENSIONS},
+        high={n: max(d[n] for d in dims) for n in DIMENSIONS},
+        node_deviation=deviation,
+        sigmas=float(sigmas),
+        cases=tuple(cases),
+        results=(centre, *results),
+    )
