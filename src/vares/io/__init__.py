@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from .._lazy import lazy_exports
 
 if TYPE_CHECKING:
+    from .biaxial import read_biaxial, write_biaxial
     from .files import OutputExistsError, atomic_path, check_writable, write_json
     from .meshes import read_mesh, read_mesh_data, read_pattern, write_surface
     from .summary import summary
