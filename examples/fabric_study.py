@@ -25,7 +25,7 @@ import numpy as np
 import vares
 from vares.analysis import compensation_report
 from vares.io.biaxial import read_biaxial, write_biaxial
-from vares.materials.biaxial import find_cycles
+from vares.io.fabric_plots import compensation_figure, loops_figure, residuals_figure
 from vares.materials.biaxial_model import (
     ECRModel,
     compensation_protocol,
@@ -33,7 +33,7 @@ from vares.materials.biaxial_model import (
     simulate,
     specimen_batch,
 )
-from vares.materials.fitting import fit_elastic, fit_fabric
+from vares.materials.fitting import compensation_values, fit_elastic, fit_fabric
 
 PRESTRESS = (2.0, 1.5)
 #: The batch's model: ECRModel.pes_pvc(); 3 % scatter of E_w, E_f, nu_wf between specimens.
@@ -107,93 +107,14 @@ def cut_sail(fabric_file: Path) -> None:
 
 
 def figures(paths: list[Path], images: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     images.mkdir(parents=True, exist_ok=True)
     record = read_biaxial(paths[0])
     fit = fit_elastic(record)
-    cycles = find_cycles(record)
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
-    colours = plt.cm.viridis(np.linspace(0, 0.9, 5))
-    for k, stage in enumerate(sorted({c.stage for c in cycles})):
-        members = [c for c in cycles if c.stage == stage]
-        span = slice(members[0].start, members[-1].end + 1)
-        last = members[-1]
-        for yarn, ax in enumerate(axes):
-            ax.plot(
-                100 * record.strain[span, yarn],
-                record.force[span, yarn],
-                color=colours[k],
-                lw=0.8,
-                label=members[0].label,
-            )
-            branch = slice(last.start, last.loaded + 1)
-            force = record.force[branch]
-            compliance = np.array(
-                [[1 / fit.E_w, -fit.nu_fw / fit.E_f], [-fit.nu_wf / fit.E_w, 1 / fit.E_f]]
-            )
-            model = (force - force[0]) @ compliance.T + record.strain[last.start]
-            ax.plot(100 * model[:, yarn], force[:, yarn], "--", color="k", lw=0.8)
-    for yarn, ax in enumerate(axes):
-        ax.set_xlabel(f"{('warp', 'fill')[yarn]} strain (%)")
-        ax.set_ylabel(f"{('warp', 'fill')[yarn]} force (kN/m)")
-        ax.grid(alpha=0.3)
-    axes[0].legend(title="warp:fill", fontsize=8)
-    fig.suptitle(
-        f"{record.name}: MSAJ/M-02 ratios, 3 cycles each; dashed: the fitted law on the last "
-        f"cycle (E1 {fit.E_w:.0f}, E2 {fit.E_f:.0f} kN/m, ν12 {fit.nu_wf:.3f})",
-        fontsize=9,
-    )
-    fig.savefig(images / "fabric_msaj_loops.png", dpi=110)
-    plt.close(fig)
-
+    loops_figure(record, fit, images / "fabric_msaj_loops.png")
+    residuals_figure([fit], images / "fabric_residuals.png", noise=MODEL.strain_noise)
     held = read_biaxial(paths[2])
-    fig, ax = plt.subplots(figsize=(8, 3.8), constrained_layout=True)
-    ax.plot(held.time / 60, 100 * held.strain[:, 0], lw=0.8, label="warp strain")
-    ax.plot(held.time / 60, 100 * held.strain[:, 1], lw=0.8, label="fill strain")
-    ax.set_xlabel("time (min)")
-    ax.set_ylabel("strain (%)")
-    twin = ax.twinx()
-    twin.plot(held.time / 60, held.force[:, 0], color="0.6", lw=0.6)
-    twin.plot(held.time / 60, held.force[:, 1], color="0.8", lw=0.6)
-    twin.set_ylabel("force (kN/m, grey)")
-    from vares.materials.fitting import compensation_values
-
     values = compensation_values(held, PRESTRESS)
-    ax.plot([values.time / 60] * 2, [100 * values.warp, 100 * values.fill], "ko")
-    ax.annotate(
-        f"compensation values\nwarp {100 * values.warp:.3f} %, fill {100 * values.fill:.3f} %",
-        (values.time / 60, 100 * values.warp),
-        xytext=(-170, 10),
-        textcoords="offset points",
-        fontsize=8,
-    )
-    ax.legend(loc="upper left", fontsize=8)
-    ax.grid(alpha=0.3)
-    ax.set_title(f"{held.name}: EN 17117-2 style protocol at 2/1.5 kN/m", fontsize=9)
-    fig.savefig(images / "fabric_compensation_record.png", dpi=110)
-    plt.close(fig)
-
-    fig, ax = plt.subplots(figsize=(7, 3.4), constrained_layout=True)
-    labels = [r.label for r in fit.residuals]
-    x = np.arange(len(labels))
-    for offset, rows, name in (
-        (-0.2, fit.residuals, "linear law"),
-        (0.2, fit.nonlinear_residuals, "nonlinear response"),
-    ):
-        rms = [1e4 * np.hypot(r.rms_warp, r.rms_fill) / np.sqrt(2) for r in rows]
-        ax.bar(x + offset, rms, width=0.38, label=name)
-    ax.axhline(1e4 * MODEL.strain_noise, color="k", lw=0.8, ls=":", label="strain noise")
-    ax.set_xticks(x, labels)
-    ax.set_xlabel("load ratio warp:fill")
-    ax.set_ylabel("RMS strain residual (10⁻⁴)")
-    ax.legend(fontsize=8)
-    ax.set_title(f"{record.name}: residual of the fit per load ratio (last cycles)", fontsize=9)
-    fig.savefig(images / "fabric_residuals.png", dpi=110)
-    plt.close(fig)
+    compensation_figure(held, values, images / "fabric_compensation_record.png")
 
 
 def main() -> None:

@@ -348,6 +348,25 @@ def test_fabric_fit_then_pattern_with_the_fabric_file(tmp_path):
     assert hyp["material"]["E1"] == pytest.approx(preset.E1)
 
 
+def test_fabric_fit_draws_its_figures(tmp_path):
+    paths = _records(tmp_path)
+    figures = tmp_path / "figures"
+    args = ("fabric", "fit", *paths, "--prestress", "2,1.5", "-o", tmp_path / "f.toml")
+    result = run(*args, "--plots", figures)
+    assert result.exit_code == 0, result.stderr
+    names = sorted(p.name for p in figures.iterdir())
+    assert names == [
+        "comp-1_compensation.png",
+        "comp-2_compensation.png",
+        "msaj-1_loops.png",
+        "msaj-2_loops.png",
+        "residuals.png",
+    ]
+    assert all((figures / n).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for n in names)
+    result = run(*args, "--plots", figures)  # nothing is overwritten without --force
+    assert result.exit_code == 2 and "output exists" in error_line(result)
+
+
 def test_fabric_fit_of_a_malformed_file_is_one_error_line(tmp_path):
     path = tmp_path / "bad.csv"
     path.write_text(DE_LAB.replace("12,5;1;100,0", "12,5;1;abc"), encoding="utf-8")

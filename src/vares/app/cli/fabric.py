@@ -77,6 +77,13 @@ def fit(
             "values; default when there are any) or 'law' (the fitted law)."
         ),
     ] = None,
+    plots: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also draw each record's loops or compensation reading and the residuals per "
+            "load ratio into this folder (PNG)."
+        ),
+    ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite the output file.")] = False,
 ) -> None:
     """Fit a fabric to biaxial test records and write a fabric file for --fabric.
@@ -115,9 +122,17 @@ def fit(
             cycle=cycle,
             reciprocal=reciprocal,
         )
-        write_text(output, fitted.to_toml(compensate_by))
+        text = fitted.to_toml(compensate_by)
+        if plots is not None:
+            from ...io.fabric_plots import fabric_figures, figure_paths
+
+            check_writable([p for *_, p in figure_paths(fitted, records, plots)], force)
+        write_text(output, text)
         _show(fitted)
         console.print(f"wrote {output}")
+        if plots is not None:
+            figures = fabric_figures(fitted, records, plots)
+            console.print(f"drew {len(figures)} figures in {plots}")
 
     guarded(body)
 
