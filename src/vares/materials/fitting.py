@@ -146,8 +146,9 @@ def _branches(record: BiaxialRecord, cycle: int) -> list[tuple[Cycle, np.ndarray
 def _design(
     record: BiaxialRecord, branches, reciprocal: bool, nonlinear: bool
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """Rows ``[warp rows; fill rows]`` of the least-squares problem, the strains, the row's
-    direction (0 warp, 1 fill) and the number of shared (non-offset) unknowns.
+    """The least-squares problem: its matrix (per load ratio a block of warp rows, then one of
+    fill rows, one row per sample of the branch), the measured strains, each row's direction
+    (0 warp, 1 fill) and the number of shared (non-offset) unknowns.
 
     Unknowns: ``a = 1/E_w``, ``c = ν_wf/E_w``, [``b = ν_fw/E_f``], ``d = 1/E_f``,
     [``k_w``, ``k_f``], then one warp and one fill offset per stage."""
@@ -183,25 +184,23 @@ def _design(
 def _weighted_lstsq(A: np.ndarray, y: np.ndarray, direction: np.ndarray):
     """Least squares with each direction's rows weighted by its residual variance; the
     solution, its covariance and the residuals."""
+    unknowns = A.shape[1]
+
+    def row_weights(residual: np.ndarray) -> np.ndarray:
+        """1/σ² per row, σ² each direction's residual variance (half the unknowns each)."""
+        variance = np.empty(2)
+        for yarn in (0, 1):
+            mask = direction == yarn
+            dof = max(mask.sum() - unknowns / 2.0, 1.0)
+            variance[yarn] = max(float(residual[mask] @ residual[mask]) / dof, 1e-30)
+        return 1.0 / variance[direction]
+
     x, *_ = np.linalg.lstsq(A, y, rcond=None)
+    root = np.sqrt(row_weights(y - A @ x))
+    x, *_ = np.linalg.lstsq(A * root[:, None], y * root, rcond=None)
     residual = y - A @ x
-    _n, p = A.shape
-    variance = np.empty(2)
-    for yarn in (0, 1):
-        mask = direction == yarn
-        dof = max(mask.sum() - p / 2.0, 1.0)
-        variance[yarn] = max(float(residual[mask] @ residual[mask]) / dof, 1e-30)
-    weights = 1.0 / variance[direction]
-    Aw = A * np.sqrt(weights)[:, None]
-    x, *_ = np.linalg.lstsq(Aw, y * np.sqrt(weights), rcond=None)
-    residual = y - A @ x
-    for yarn in (0, 1):
-        mask = direction == yarn
-        dof = max(mask.sum() - p / 2.0, 1.0)
-        variance[yarn] = max(float(residual[mask] @ residual[mask]) / dof, 1e-30)
-    weights = 1.0 / variance[direction]
-    Aw = A * np.sqrt(weights)[:, None]
-    covariance = np.linalg.inv(Aw.T @ Aw)
+    scaled = A * np.sqrt(row_weights(residual))[:, None]
+    covariance = np.linalg.inv(scaled.T @ scaled)
     return x, covariance, residual
 
 
