@@ -7,6 +7,10 @@ known, driven through the load protocols the standards prescribe, with measureme
 The model: the **elastic–creep–ratchet (ECR) fabric model**
 --------------------------------------------------------------
 
+A model put together for vares from standard pieces (a complementary-energy backbone,
+Norton–Bailey creep, a saturating ratchet); it is not fitted to any real fabric, only made to
+show what real records show: nonlinearity, hysteresis, permanent set and creep.
+
 The strain of a specimen under the force per width ``σ = (σ_w, σ_f)`` (kN/m) is the sum of three
 parts and the noise of the measurement,
 
@@ -146,10 +150,11 @@ def msaj_protocol(
 ) -> list[Leg]:
     """The MSAJ/M-02 protocol: each load ratio (warp:fill) cycled ``cycles`` times.
 
-    ``largest``: the largest warp and fill forces (kN/m; MSAJ takes a quarter of the strip
-    tensile strength); a ratio's larger part goes to its direction's largest force, the other
-    in proportion, a 0 part stays at ``preload`` (kN/m). ``rate``: loading and unloading rate of
-    the leading direction (kN/m per s). Stage ``i`` is the ``i``-th ratio (1-based).
+    ``largest``: the largest warp and fill forces (kN/m; the standard relates them to the
+    fabric's tensile strength); a ratio's larger part goes to its direction's largest force,
+    the other in proportion, a 0 part stays at ``preload`` (kN/m). ``rate``: loading and
+    unloading rate of the leading direction (kN/m per s). Stage ``i`` is the ``i``-th ratio
+    (1-based).
     """
     legs = [Leg(preload / rate, (preload, preload), 0)]
     for stage, (rw, rf) in enumerate(ratios, start=1):
