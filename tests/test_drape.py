@@ -411,15 +411,13 @@ def test_fabric_kinds_carry_labelled_locking_angles():
 
 
 def test_drape_command_writes_the_producibility(tmp_path):
-    from vares.app.cli.drape import FABRIC_KIND_NAMES
     from vares.io.meshes import write_surface
 
-    assert FABRIC_KIND_NAMES == tuple(FABRIC_KINDS)
     mesh = spherical_cap(R, 90.0, 20)
     surface = tmp_path / "hemisphere.obj"
     write_surface(surface, mesh)
     out = tmp_path / "out"
-    args = ["drape", surface, "--seed", 0, 0, R, "--warp", 1, 0, 0, "--spacing", 3, "-o", out]
+    args = ["drape", surface, "--seed", "0,0,100", "--warp", "1,0,0", "--spacing", 3, "-o", out]
     result = run(*args, "--fabric-kind", "woven-plain")
     assert result.exit_code == 0, result.stderr
     assert "producibility (locking 40°, warn from 32°)" in result.stderr
@@ -428,6 +426,7 @@ def test_drape_command_writes_the_producibility(tmp_path):
     expected = producibility(direct.shear_angle, mesh.cell_areas(), 40.0)
     assert data["producibility"]["limit_fraction"] == pytest.approx(expected.fractions["limit"])
     assert data["producibility"]["limit_fraction"] > 0.01
+    assert data["locking_angle_source"] == FABRIC_KINDS["woven-plain"].source
     written = meshio.read(out / "drape.vtu")
     assert np.allclose(written.cell_data["shear_angle"][0], direct.shear_angle, equal_nan=True)
     assert written.cell_data["warp"][0].shape == (mesh.num_cells, 3)
@@ -436,5 +435,35 @@ def test_drape_command_writes_the_producibility(tmp_path):
     again = run(*args, "--locking-angle", "60", "--force", "-q")
     assert again.exit_code == 0
     assert json.loads((out / "drape.json").read_text())["producibility"]["limit_fraction"] == 0.0
-    off = run("drape", surface, "--seed", 0, 0, 3 * R, "-o", tmp_path / "off")
-    assert off.exit_code == 2 and "not on the mould" in error_line(off)
+    for flag, value, message in [
+        ("--locking-angle", "95", "at most 90"),
+        ("--warn-fraction", "1.5", "at most 1"),
+        ("--fabric-kind", "denim", "woven-twill"),
+        ("--seed", "0,0,300", "not on the mould"),
+    ]:
+        refused = run("drape", surface, flag, value, "-o", tmp_path / "refused")
+        assert refused.exit_code == 2 and message in refused.stderr, refused.stderr
+
+
+def test_drape_ply_takes_its_options_once():
+    from vares.analysis.drape import DrapeOptions, drape_ply
+    from vares.options import OptionsError
+
+    mesh = spherical_cap(R, 90.0, 20)
+    ply = drape_ply(mesh, spacing=3.0, locking_angle=45.0)
+    assert ply.producibility.locking_angle == 45.0 and ply.options.locking[1] == "given"
+    assert np.allclose(ply.seed, [0, 0, R])  # the node nearest the centroid: the pole
+    direct = kinematic_drape(mesh, [0, 0, R], [1, 0, 0], 3.0)
+    assert np.allclose(ply.drape.shear_angle, direct.shear_angle, equal_nan=True)
+    assert ply.summary()["producibility"]["max_shear"] == pytest.approx(
+        np.nanmax(np.abs(direct.shear_angle))
+    )
+    default = drape_ply(mesh)
+    edges = mesh.edges()
+    mean_edge = np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1).mean()
+    assert default.spacing == pytest.approx(mean_edge / 2)
+    assert default.producibility.locking_angle == FABRIC_KINDS["woven-twill"].locking_angle
+    with pytest.raises(OptionsError, match="at most 90"):
+        DrapeOptions(locking_angle=120.0)
+    with pytest.raises(OptionsError, match="spacng"):
+        drape_ply(mesh, spacng=2.0)

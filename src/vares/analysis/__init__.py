@@ -10,6 +10,8 @@ if TYPE_CHECKING:
     from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
     from .checks import pattern_warnings
     from .compensation import CompensationReport, YarnReport, compensation_report
+    from .drape import PlyDrape, drape_ply
+    from .drape_options import DrapeOptions
     from .erection import ErectionResult, erect
     from .erection_model import Pattern
     from .evaluate import PatternEvaluation, evaluate

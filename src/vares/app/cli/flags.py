@@ -48,6 +48,7 @@ PANELS = {
     "structure": "Structure",
     "erection": "Erection",
     "cut": "Cutting and nesting",
+    "drape": "Drape and producibility",
 }
 #: Kinds given on the command line as one comma-separated string.
 _TEXT_KINDS = {"vector", "plane", "floats", "strings", "paths"}
