@@ -2,6 +2,7 @@
 
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -419,3 +420,12 @@ def test_pattern_band_of_a_flat_panel_is_the_closed_form(tmp_path):
     assert band.high["boundary_length"] == pytest.approx(2 * (3 / 1.0078 + 2 / 1.0057), rel=1e-8)
     corner = np.hypot(1.5 * (1 / 1.0078 - 1 / 1.008), 1.0 * (1 / 1.0057 - 1 / 1.006))
     assert band.node_deviation == pytest.approx(corner, rel=1e-5)
+
+
+def test_fabric_band_command():
+    shipped = Path(__file__).parent.parent / "examples" / "biaxial" / "pes-batch-42.toml"
+    result = run("fabric", "band", "--example", "hypar", "--fabric", shipped)
+    assert result.exit_code == 0, result.stderr
+    assert "warp length" in result.stderr and "largest node movement" in result.stderr
+    result = run("fabric", "band", "--fabric", shipped)
+    assert result.exit_code == 2 and "one of a mesh file and --example" in error_line(result)

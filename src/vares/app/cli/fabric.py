@@ -1,4 +1,6 @@
-"""``vares fabric fit``: a fabric file from biaxial test records (docs/fabrics.md)."""
+"""``vares fabric fit``: a fabric file from biaxial test records; ``vares fabric band``: the
+band of a panel's pattern under the scatter of the fabric's compensation values
+(docs/fabrics.md)."""
 
 from pathlib import Path
 from typing import Annotated
@@ -8,7 +10,7 @@ import typer
 from .common import console, guarded
 from .flags import InputError
 
-__all__ = ["fabric_app", "fit"]
+__all__ = ["band", "fabric_app", "fit"]
 
 fabric_app = typer.Typer(
     help="Fabrics from biaxial tests: fit constants and compensation values to test records.",
@@ -204,3 +206,74 @@ def _show(fitted) -> None:
         if law is not None:
             values.add_row("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %")
         console.print(values)
+
+
+@fabric_app.command("band")
+def band(
+    fabric_file: Annotated[
+        Path,
+        typer.Option(
+            "--fabric", help="A fabric file with measured compensation values and their scatter."
+        ),
+    ],
+    mesh: Annotated[
+        Path | None, typer.Argument(metavar="MESH", help="The panel's surface mesh file.")
+    ] = None,
+    example: Annotated[
+        str | None, typer.Option(help="A shipped example surface instead of a file.")
+    ] = None,
+    prestress: Annotated[
+        str | None,
+        typer.Option(help="Prestress 'warp,fill' (kN/m; default: the one measured at)."),
+    ] = None,
+    warp_direction: Annotated[
+        str | None, typer.Option(help="Warp direction 'x,y,z' on the surface.")
+    ] = None,
+    sigmas: Annotated[
+        float, typer.Option(help="Half-width of the band in standard deviations.")
+    ] = 1.0,
+) -> None:
+    """The band of a panel's pattern under the scatter of its fabric's compensation values:
+    length along the warp, width along the fill, boundary length and area, at the mean values
+    and at mean ± SIGMAS standard deviations of warp and fill (docs/fabrics.md)."""
+
+    def body() -> None:
+        from rich.table import Table
+
+        from ...analysis.scatter import pattern_band
+        from ...geometry.examples import EXAMPLES
+        from ...io.meshes import read_mesh
+        from ...materials.presets import file_fabric
+
+        if (mesh is None) == (example is None):
+            raise InputError("give one of a mesh file and --example")
+        if example is not None and example not in EXAMPLES:
+            raise InputError(f"--example must be one of {', '.join(EXAMPLES)}; got {example!r}")
+        surface = EXAMPLES[example]() if example is not None else read_mesh(mesh)
+        settings = {}
+        if warp_direction is not None:
+            try:
+                direction = tuple(float(v) for v in warp_direction.split(","))
+            except ValueError:
+                direction = ()
+            if len(direction) != 3:
+                raise InputError(f"--warp-direction takes three numbers; got {warp_direction!r}")
+            settings["warp_direction"] = direction
+        preset = file_fabric(fabric_file)
+        result = pattern_band(
+            surface, preset, _pair(prestress, "--prestress"), sigmas=sigmas, **settings
+        )
+        c = preset.compensation
+        table = Table(
+            "",
+            "mean values",
+            f"mean ± {sigmas:g} std",
+            title=f"{preset.name}: warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, fill "
+            f"{100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % (pattern units)",
+        )
+        for row in result.rows():
+            table.add_row(*row)
+        table.add_row("largest node movement", "", f"{result.node_deviation:.4g}")
+        console.print(table)
+
+    guarded(body)
