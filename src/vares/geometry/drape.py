@@ -108,7 +108,9 @@ def _in_plane(vectors: np.ndarray, normals: np.ndarray) -> np.ndarray:
     return vectors / np.linalg.norm(vectors, axis=1)[:, None]
 
 
-def _locate_in_net(net: KinematicNet, queries: np.ndarray, limit: float, near: int = 4):
+def _locate_in_net(
+    net: KinematicNet, queries: np.ndarray, limit: float, near: int = 4, chunk: int = 8192
+):
     """For each query point ``(k, 3)``: the net triangle it lies in as ``(i, j, t)`` ``(k, 3)``
     (the cell ``(i, j)``, its triangle ``t``; −1 if none within ``limit``), the barycentric
     weights ``(k, 3)`` of its corners, and whether the point lies inside the net ``(k,)``.
@@ -119,14 +121,32 @@ def _locate_in_net(net: KinematicNet, queries: np.ndarray, limit: float, near: i
     """
     from scipy.spatial import cKDTree
 
-    count = len(queries)
-    cell = np.full((count, 3), -1, dtype=np.int64)
-    weights = np.full((count, 3), np.nan)
     valid = net.valid
     nodes = np.argwhere(valid)
     if len(nodes) < 3:
         raise DrapeError("the net has fewer than three nodes: the spacing is too large")
-    distance, nearest = cKDTree(net.positions[valid]).query(queries, k=min(near, len(nodes)))
+    tree = cKDTree(net.positions[valid])
+    cell = np.full((len(queries), 3), -1, dtype=np.int64)
+    weights = np.full((len(queries), 3), np.nan)
+    inside = np.zeros(len(queries), dtype=bool)
+    # most points lie in a cell of their nearest node; the others look round more nodes
+    for count, rows in ((1, np.arange(len(queries))), (min(near, len(nodes)), None)):
+        if rows is None:
+            rows = np.flatnonzero(~inside)
+        for start in range(0, len(rows), chunk):  # bounds the (k, 8 count, 3, 3) candidates
+            part = rows[start : start + chunk]
+            distance, nearest = tree.query(queries[part], k=count)
+            cell[part], weights[part], inside[part] = _locate_chunk(
+                net, nodes, queries[part], distance, nearest, limit
+            )
+    return cell, weights, inside
+
+
+def _locate_chunk(net, nodes, queries, distance, nearest, limit):
+    count = len(queries)
+    cell = np.full((count, 3), -1, dtype=np.int64)
+    weights = np.full((count, 3), np.nan)
+    valid = net.valid
     distance, nearest = distance.reshape(count, -1), nearest.reshape(count, -1)
     nu, nv = valid.shape
     offsets = np.array([[-1, -1], [-1, 0], [0, -1], [0, 0]])
