@@ -293,10 +293,22 @@ def _records(folder):
 
 def test_fabric_fit_then_pattern_with_the_fabric_file(tmp_path):
     paths = _records(tmp_path)
-    target = tmp_path / "pes-batch-42.toml"
-    result = run("fabric", "fit", *paths, "--prestress", "2,1.5", "-o", target)
+    target, figures = tmp_path / "pes-batch-42.toml", tmp_path / "figures"
+    fit = ("fabric", "fit", *paths, "--prestress", "2,1.5", "-o", target, "--plots", figures)
+    result = run(*fit)
     assert result.exit_code == 0, result.stderr
     assert "compensation values at 2/1.5 kN/m" in result.stderr
+    names = sorted(p.name for p in figures.iterdir())
+    assert names == [
+        "comp-1_compensation.png",
+        "comp-2_compensation.png",
+        "msaj-1_loops.png",
+        "msaj-2_loops.png",
+        "residuals.png",
+    ]
+    assert all((figures / n).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for n in names)
+    result = run(*fit)  # nothing is overwritten without --force
+    assert result.exit_code == 2 and "output exists" in error_line(result)
     preset = fabric(str(target))
     assert preset.name == "pes-batch-42" and preset.compensate_by == "measured"
     assert "not measured by biaxial tests" in preset.source and "msaj-1.csv" in preset.source
@@ -347,25 +359,6 @@ def test_fabric_fit_then_pattern_with_the_fabric_file(tmp_path):
     assert result.exit_code == 0, result.stderr
     hyp = json.loads((tmp_path / "hyp" / "summary.json").read_text())
     assert hyp["material"]["E1"] == pytest.approx(preset.E1)
-
-
-def test_fabric_fit_draws_its_figures(tmp_path):
-    paths = _records(tmp_path)
-    figures = tmp_path / "figures"
-    args = ("fabric", "fit", *paths, "--prestress", "2,1.5", "-o", tmp_path / "f.toml")
-    result = run(*args, "--plots", figures)
-    assert result.exit_code == 0, result.stderr
-    names = sorted(p.name for p in figures.iterdir())
-    assert names == [
-        "comp-1_compensation.png",
-        "comp-2_compensation.png",
-        "msaj-1_loops.png",
-        "msaj-2_loops.png",
-        "residuals.png",
-    ]
-    assert all((figures / n).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for n in names)
-    result = run(*args, "--plots", figures)  # nothing is overwritten without --force
-    assert result.exit_code == 2 and "output exists" in error_line(result)
 
 
 def test_fabric_fit_of_a_malformed_file_is_one_error_line(tmp_path):
