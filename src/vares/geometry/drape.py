@@ -40,7 +40,9 @@ class KinematicDrape:
     the decrease of the angle between the +warp and +fill yarns from 90°), ``warp`` and ``fill``
     ``(m, 3)`` (unit yarn directions in the cell's plane). Per mesh node ``(n,)``:
     ``material_coordinates`` ``(n, 2)`` (the flat pattern the net implies, the seed at the origin,
-    the warp along +x). NaN where the net does not reach (module docs).
+    the warp along +x). NaN where the net does not reach (module docs). ``node_in_net`` ``(n,)``
+    and ``cell_in_net`` ``(m,)``: True where the node or the cell's centroid lies inside the net
+    (interpolated), False where it was extrapolated or is NaN.
     """
 
     net: KinematicNet
@@ -53,6 +55,7 @@ class KinematicDrape:
 
     @property
     def spacing(self) -> float:
+        """The net's yarn spacing (mesh length units)."""
         return self.net.spacing
 
 
