@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 
@@ -87,7 +88,9 @@ _WORDS = {
 _COLUMNS = ("time", "warp force", "fill force", "warp strain", "fill strain")
 
 
-def _fail(path: Path, line: int, message: str, column: int | None = None, name: str = "") -> None:
+def _fail(
+    path: Path, line: int, message: str, column: int | None = None, name: str = ""
+) -> NoReturn:
     where = f"{path}, line {line}"
     if column is not None:
         where += f", column {column}" + (f" ({name})" if name else "")
@@ -291,7 +294,7 @@ def _data_line(lines: list[str], first_data: int, index: int) -> int:
     return len(lines)
 
 
-def _number(cell: str, decimal_comma: bool, path: Path, line: int, column: int, name: str):
+def _number(cell: str, decimal_comma: bool, path: Path, line: int, column: int, name: str) -> float:
     text = cell.strip().strip('"').replace("\u202f", "").replace("\xa0", "")
     if decimal_comma:
         text = text.replace(",", ".")

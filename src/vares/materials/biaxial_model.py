@@ -259,8 +259,10 @@ def simulate(
 
 
 def _creep_step(
-    creep: np.ndarray, force: np.ndarray, dt: float, A: np.ndarray, model
+    creep: np.ndarray, force: np.ndarray, dt: float, A: np.ndarray, model: ECRModel
 ) -> np.ndarray:
+    """Creep strain ``(2,)`` after ``dt`` s at the constant ``force`` ``(2,)`` (kN/m), from
+    the equivalent time of the creep strain reached so far (strain hardening)."""
     level = A * (np.maximum(force, 0.0) / model.creep_reference) ** model.creep_n
     out = creep.copy()
     active = level > 0

@@ -144,7 +144,10 @@ def _branches(record: BiaxialRecord, cycle: int) -> list[tuple[Cycle, np.ndarray
 
 
 def _design(
-    record: BiaxialRecord, branches, reciprocal: bool, nonlinear: bool
+    record: BiaxialRecord,
+    branches: list[tuple[Cycle, np.ndarray]],
+    reciprocal: bool,
+    nonlinear: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """The least-squares problem: its matrix (per load ratio a block of warp rows, then one of
     fill rows, one row per sample of the branch), the measured strains, each row's direction
@@ -181,7 +184,9 @@ def _design(
     return np.vstack(rows), np.concatenate(rhs), np.concatenate(direction), shared
 
 
-def _weighted_lstsq(A: np.ndarray, y: np.ndarray, direction: np.ndarray):
+def _weighted_lstsq(
+    A: np.ndarray, y: np.ndarray, direction: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Least squares with each direction's rows weighted by its residual variance; the
     solution, its covariance and the residuals."""
     unknowns = A.shape[1]
@@ -204,7 +209,9 @@ def _weighted_lstsq(A: np.ndarray, y: np.ndarray, direction: np.ndarray):
     return x, covariance, residual
 
 
-def _constants(x: np.ndarray, covariance: np.ndarray, reciprocal: bool):
+def _constants(
+    x: np.ndarray, covariance: np.ndarray, reciprocal: bool
+) -> tuple[dict[str, float], dict[str, float]]:
     """``E_w, E_f, ν_wf, ν_fw`` and their standard errors from the compliances."""
     if reciprocal:
         a, c, d = x[:3]
@@ -239,7 +246,10 @@ def _constants(x: np.ndarray, covariance: np.ndarray, reciprocal: bool):
     return values, errors
 
 
-def _residuals(branches, residual: np.ndarray) -> tuple[RatioResidual, ...]:
+def _residuals(
+    branches: list[tuple[Cycle, np.ndarray]], residual: np.ndarray
+) -> tuple[RatioResidual, ...]:
+    """RMS residual per load ratio; ``residual``: all warp rows, then all fill rows."""
     out, offset = [], 0
     lengths = [len(index) for _, index in branches]
     total = sum(lengths)
@@ -261,7 +271,7 @@ def _residuals(branches, residual: np.ndarray) -> tuple[RatioResidual, ...]:
     return tuple(out)
 
 
-def _reorder(residual: np.ndarray, branches) -> np.ndarray:
+def _reorder(residual: np.ndarray, branches: list[tuple[Cycle, np.ndarray]]) -> np.ndarray:
     """Residuals stacked per stage (warp block, fill block) → all warp rows, then all fill."""
     warp, fill, offset = [], [], 0
     for _, index in branches:
@@ -424,7 +434,9 @@ def summarise(rows: list[dict[str, float]]) -> Summary:
     return Summary(mean, std, values, len(rows))
 
 
-def _flat_stationarity(Q11, Q12, Q22, E11, E22, p1, p2):
+def _flat_stationarity(
+    Q11: float, Q12: float, Q22: float, E11: float, E22: float, p1: float, p2: float
+) -> np.ndarray:
     """Residuals of the flat uniform VaReS optimum: ``λ_i² S̃_ii − Ψ̃`` for i = 1, 2."""
     S1 = Q11 * E11 + Q12 * E22 - p1
     S2 = Q12 * E11 + Q22 * E22 - p2

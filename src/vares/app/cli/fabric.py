@@ -3,12 +3,15 @@ band of a panel's pattern under the scatter of the fabric's compensation values
 (docs/fabrics.md)."""
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from .common import console, guarded
 from .flags import InputError
+
+if TYPE_CHECKING:  # the engine is imported when a command runs
+    from ...materials.fitting import FabricFit
 
 __all__ = ["band", "fabric_app", "fit"]
 
@@ -139,7 +142,8 @@ def fit(
     guarded(body)
 
 
-def _show(fitted) -> None:
+def _show(fitted: "FabricFit") -> None:
+    """The fit's tables: constants per specimen, residual per load ratio, compensation."""
     from rich.table import Table
 
     table = Table(
