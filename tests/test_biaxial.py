@@ -326,8 +326,10 @@ def test_fabric_fit_then_pattern_with_the_fabric_file(tmp_path):
     # the file wherever a preset goes: a pattern compensated by the measured values …
     out = tmp_path / "sail"
     flags = ("--prestress", "2,1.5", "--warp-direction", "1,1,0", "-q")
-    result = run("example", "sail", "-o", out, "--fabric", target, *flags)
+    result = run("example", "sail", "-o", out, "--fabric", target, *flags, "--report")
     assert result.exit_code == 0, result.stderr
+    report = (out / "report.html").read_text(encoding="utf-8")
+    assert "measured compensation at 2 / 1.5" in report and "msaj-1.csv" in report
     summary = json.loads((out / "summary.json").read_text())
     warp = summary["compensation"]["warp"]["compensation_mean"]
     assert warp == pytest.approx(100 * measured.warp / (1 + measured.warp), rel=0.02)

@@ -61,6 +61,7 @@ def _material_section(result, job: Job, material: Hyperelastic) -> list[str]:
     rows.append(("thickness", result.thickness))
     if job.material.fabric is not None:
         rows.append(("fabric preset", job.material.fabric))
+    rows += _fabric_file_rows(job)
     rows.append(("fibre orientation", result.orientation))
     warp, fill = (np.round(v, 4).tolist() for v in (result.fibres.warp, result.fibres.fill))
     rows.append(("warp / fill in the pattern", f"{warp} / {fill}"))
@@ -77,6 +78,29 @@ def _material_section(result, job: Job, material: Hyperelastic) -> list[str]:
             )
         )
     return ["<h2>Material and fibres</h2>", table(rows, ident="material")]
+
+
+def _fabric_file_rows(job: Job) -> list[tuple[str, object]]:
+    """Where a fabric from biaxial tests came from and what it measured (docs/fabrics.md)."""
+    if job.material.presets is None:
+        return []
+    from ..materials.presets import fabric, file_fabric
+
+    path = job.path(job.material.presets)
+    name = job.material.fabric
+    preset = file_fabric(path) if name is None else fabric(name, path)
+    rows: list[tuple[str, object]] = [("fabric file", str(path)), ("source", preset.source)]
+    c = preset.compensation
+    if c is not None:
+        rows.append(("compensated by", job.material.compensate_by or preset.compensate_by))
+        rows.append(
+            (
+                f"measured compensation at {number(c.prestress[0])} / {number(c.prestress[1])}",
+                f"warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, "
+                f"fill {100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % (mean ± std)",
+            )
+        )
+    return rows
 
 
 def _key_figures(outcome: PanelOutcome, unit_names: dict[str, str]) -> list[str]:
