@@ -2,20 +2,32 @@
 roll width, cut outlines with allowances per edge and nesting on the roll."""
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
 from shapely.geometry import Polygon
 
+from vares import read_mesh
 from vares.geometry.cutting import cut_mesh
 from vares.geometry.drawn_lines import closest_points, curves_on_surface
 from vares.geometry.examples import cone_segment, cylinder160, hypar, saddle
 from vares.geometry.line_families import geodesic_between_ends, line_family
 from vares.geometry.outline import allowance_outline
-from vares.geometry.surface_lines import CuttingError, geodesic_lines, plane_sections
+from vares.geometry.refine import refine, refine_once
+from vares.geometry.surface_lines import (
+    CuttingError,
+    geodesic_lines,
+    min_angles,
+    plane_sections,
+    triangulated,
+)
 from vares.structures import find_seams, split_panels
-from vares.structures.layout import plan_strips
+from vares.structures.layout import CELLS_ACROSS, plan_strips
 from vares.structures.nesting import nest_pieces, usable_width
+
+#: Form-found design meshes (tests/data/README.md).
+DATA = Path(__file__).parent / "data"
 
 
 def developed(line, flat: np.ndarray) -> np.ndarray:
@@ -198,3 +210,81 @@ def test_a_piece_as_wide_as_the_roll_is_refused_by_the_nest_as_by_the_cut():
     placed = Polygon(nest.pieces[0].place(fitting))
     assert placed.bounds[1] >= 0 and placed.bounds[3] <= roll
     assert nest.length == pytest.approx(3.0, rel=1e-9)
+
+
+def longest_edge(mesh) -> float:
+    edges = mesh.edges()
+    return float(np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1).max())
+
+
+def off_surface(mesh, points: np.ndarray, sample: int = 200) -> float:
+    """Largest distance from the surface of ``sample`` of the ``points`` (drawn at random)."""
+    chosen = np.random.default_rng(0).choice(len(points), min(sample, len(points)), replace=False)
+    return float(closest_points(mesh, points[chosen])[2].max())
+
+
+def test_refining_keeps_the_surface():
+    """Refined on its own faces: edges no longer than asked, the same area, every node on the
+    input surface; a round that splits every cell keeps every angle (1-to-4), one that splits
+    some keeps the others and leaves no hanging node (the mesh is manifold and one piece)."""
+    mesh = triangulated(read_mesh(DATA / "hypar_sail.obj"))
+    fine, rounds = refine(mesh, 4.0)
+    assert rounds == 2 and longest_edge(fine) <= 4.0
+    assert fine.area == pytest.approx(mesh.area, rel=1e-13)
+    assert off_surface(mesh, fine.points) <= 1e-12 * np.ptp(mesh.points, axis=0).max()
+    assert len(mesh.points) < len(fine.points) and set(map(tuple, mesh.points)) <= set(
+        map(tuple, fine.points)
+    )
+    uniform = refine_once(mesh, 0.0)
+    assert len(uniform.cells["triangle"]) == 4 * len(mesh.cells["triangle"])
+    assert min_angles(uniform.points, uniform.cells["triangle"]).min() == pytest.approx(
+        min_angles(mesh.points, mesh.cells["triangle"]).min(), abs=1e-9
+    )
+    partial = refine_once(mesh, 8.0)  # only the long cells near the corners
+    kept = {tuple(sorted(t)) for t in mesh.cells["triangle"].tolist()}
+    now = {tuple(sorted(t)) for t in partial.cells["triangle"].tolist()}
+    assert 0 < len(kept & now) < len(kept)
+    assert len(partial.boundary_loops()) == 1
+    assert partial.area == pytest.approx(mesh.area, rel=1e-13)
+    assert refine_once(mesh, 11.0) is mesh  # no edge longer: nothing to do
+
+
+def line_distance(first: np.ndarray, second: np.ndarray, parts: int = 8) -> float:
+    """Smallest distance between two polylines ``(k, 3)``, sampled ``parts`` times per segment."""
+    from scipy.spatial import cKDTree
+
+    def dense(points):
+        t = np.linspace(0.0, 1.0, parts, endpoint=False)[:, None, None]
+        pieces = points[:-1] + t * (points[1:] - points[:-1])
+        return np.vstack([pieces.reshape(-1, 3), points[-1:]])
+
+    return float(cKDTree(dense(first)).query(dense(second))[0].min())
+
+
+@pytest.mark.parametrize(
+    ("name", "subdivisions", "width"),
+    [("hypar_sail.obj", 0, 10.0), ("hypar_sail.obj", 1, 10.0), ("fofin_wave.obj", 0, 1.5)],
+)
+def test_coarse_designs_are_cut_into_strips_of_roll_width(name, subdivisions, width):
+    """Form-found meshes with cells as wide as a strip and edges that sag inwards (the sections
+    near them cut the surface twice, the geodesics between their ends hug the edge): the
+    strips fit, one gap fewer does not, the strips are the surface, the lines stay apart, the
+    surface was refined where its cells were too large for the strips."""
+    mesh = triangulated(read_mesh(DATA / name))
+    if subdivisions:
+        mesh, _ = refine(mesh, 0.0, max_rounds=subdivisions)
+    plan = plan_strips(mesh, width)
+    assert max(plan.widths) <= width
+    gaps = dict(plan.history)
+    best = min(n for n, widest in gaps.items() if widest <= width)
+    assert gaps[best - 1] > width
+    assert len(plan.panels) >= best
+    assert sum(p.mesh.area for p in plan.panels) == pytest.approx(mesh.area, rel=1e-12)
+    size = np.ptp(mesh.points, axis=0).max()
+    assert off_surface(mesh, plan.cut.mesh.points) <= 1e-9 * size
+    assert longest_edge(plan.cut.mesh) <= width / CELLS_ACROSS
+    if longest_edge(mesh) > width / CELLS_ACROSS:
+        assert plan.refinements >= 1 and plan.input_cells == len(mesh.cells["triangle"])
+    chains = [plan.cut.mesh.points[c] for c in plan.cut.lines]
+    for first, second in itertools.combinations(chains, 2):
+        assert line_distance(first[1:-1], second[1:-1]) > 0.02 * width

@@ -27,11 +27,15 @@ from scipy.sparse.csgraph import connected_components
 from .mesh import SurfaceMesh
 from .surface_lines import CuttingError, SurfaceLine, check_triangles, mesh_edges, min_angles
 
-__all__ = ["CutMesh", "cut_mesh"]
+__all__ = ["CutMesh", "LinesMeetError", "cut_mesh"]
 
 #: Crossings closer than this fraction of the edge length to a node are moved onto the node, and
 #: so is a line that passes a cell's corner closer than this fraction of the cell's edges.
 SNAP = 0.05
+
+
+class LinesMeetError(CuttingError):
+    """Two cutting lines cross or touch (after their crossings near nodes were moved onto them)."""
 
 
 @dataclass(frozen=True)
@@ -103,8 +107,10 @@ def cut_mesh(
 
     Raises
     ------
+    LinesMeetError
+        Two lines cross or touch.
     CuttingError
-        Two lines cross or touch, or a line leaves the cells it should run through.
+        A line leaves the cells it should run through.
     """
     triangles = check_triangles(mesh)
     num_input = mesh.num_points
@@ -126,9 +132,11 @@ def cut_mesh(
         touched.update(faces_at_edge[(a, b)])
     kept = np.ones(len(triangles), dtype=bool)
     new_cells = []
-    for face in sorted(touched):
-        kept[face] = False
-        new_cells += _split_face(triangles[face], points, nodes, chords.get(face, []))
+    faces = np.array(sorted(touched), dtype=np.int64)
+    kept[faces] = False
+    origins, frames = _cell_frames(points, triangles[faces])
+    for face, origin, axes in zip(faces.tolist(), origins, frames, strict=True):
+        new_cells += _split_face(triangles[face], points, nodes, chords.get(face, []), origin, axes)
     cells = np.vstack([triangles[kept], np.array(new_cells, dtype=np.int64).reshape(-1, 3)])
     cut = SurfaceMesh(points, {"triangle": cells})
     seam_edges = np.array(sorted(seams), dtype=np.int64).reshape(-1, 2)
@@ -214,22 +222,44 @@ def _check_disjoint(chains: list[list[int]], num_input: int, nodes: _Nodes) -> N
         if len(who) > 1 and any(node not in (chains[i][0], chains[i][-1]) for i in who):
             first, second = sorted(who)[:2]
             where = nodes.points[node]
-            raise CuttingError(
+            raise LinesMeetError(
                 f"cutting lines {first + 1} and {second + 1} meet at "
                 f"({where[0]:.6g}, {where[1]:.6g}, {where[2]:.6g}): lines must not cross "
                 "or touch (place them further apart, or refine the mesh)"
             )
 
 
-def _incidence(triangles: np.ndarray):
-    faces_at_node: dict[int, set[int]] = defaultdict(set)
-    faces_at_edge: dict[tuple[int, int], list[int]] = defaultdict(list)
-    for face, corners in enumerate(triangles.tolist()):
-        for k in range(3):
-            faces_at_node[corners[k]].add(face)
-            a, b = corners[k], corners[(k + 1) % 3]
-            faces_at_edge[(min(a, b), max(a, b))].append(face)
-    return faces_at_node, faces_at_edge
+class _FacesAtNode:
+    """The cells at every node of a triangle mesh, looked up when asked for (``[node]``: a set)."""
+
+    def __init__(self, triangles: np.ndarray) -> None:
+        corners = triangles.ravel()
+        self.order = np.argsort(corners, kind="stable") // 3
+        self.start = np.concatenate([[0], np.cumsum(np.bincount(corners))])
+
+    def __getitem__(self, node: int) -> set[int]:
+        if node + 1 >= len(self.start):
+            return set()
+        return set(self.order[self.start[node] : self.start[node + 1]].tolist())
+
+
+class _FacesAtEdge:
+    """The cells at every edge ``(a, b)`` (``a < b``) of a triangle mesh (``[edge]``: a list;
+    ``edge in``: whether it is an edge)."""
+
+    def __init__(self, at_node: _FacesAtNode) -> None:
+        self.at_node = at_node
+
+    def __getitem__(self, edge: tuple[int, int]) -> list[int]:
+        return sorted(self.at_node[edge[0]] & self.at_node[edge[1]])
+
+    def __contains__(self, edge: tuple[int, int]) -> bool:
+        return bool(self[edge])
+
+
+def _incidence(triangles: np.ndarray) -> tuple[_FacesAtNode, _FacesAtEdge]:
+    at_node = _FacesAtNode(triangles)
+    return at_node, _FacesAtEdge(at_node)
 
 
 def _support(node: int, nodes: _Nodes, faces_at_node, faces_at_edge, num_input: int) -> set[int]:
@@ -286,10 +316,26 @@ def _along_edge(edge: tuple[int, int], u: int, w: int, nodes: _Nodes) -> list[tu
     return [(min(p, q), max(p, q)) for p, q in itertools.pairwise(chain)]
 
 
+def _cell_frames(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every triangle's first corner ``(m, 3)`` and two orthonormal axes of its plane
+    ``(m, 2, 3)``, the first along its first side."""
+    origin = points[triangles[:, 0]]
+    first = points[triangles[:, 1]] - origin
+    normal = np.cross(first, points[triangles[:, 2]] - origin)
+    axes = np.stack([first, np.cross(normal, first)], axis=1)
+    return origin, axes / np.linalg.norm(axes, axis=2, keepdims=True)
+
+
 def _split_face(
-    corners: np.ndarray, points: np.ndarray, nodes: _Nodes, chords: list[tuple[int, int]]
+    corners: np.ndarray,
+    points: np.ndarray,
+    nodes: _Nodes,
+    chords: list[tuple[int, int]],
+    origin: np.ndarray,
+    axes: np.ndarray,
 ) -> list[tuple[int, int, int]]:
-    """The triangles a cell is split into by the crossings on its edges and its chords."""
+    """The triangles a cell is split into by the crossings on its edges and its chords
+    (``origin`` and ``axes``: the cell's frame, :func:`_cell_frames`)."""
     cycle: list[int] = []
     for k in range(3):
         a, b = int(corners[k]), int(corners[(k + 1) % 3])
@@ -300,10 +346,6 @@ def _split_face(
     polygons = [cycle]
     for u, w in chords:
         polygons = _split_polygon(polygons, u, w, points)
-    origin, e1 = points[corners[0]], points[corners[1]] - points[corners[0]]
-    normal = np.cross(e1, points[corners[2]] - points[corners[0]])
-    axes = np.array([e1, np.cross(normal, e1)])
-    axes /= np.linalg.norm(axes, axis=1)[:, None]
     out = []
     for polygon in polygons:
         flat = (points[polygon] - origin) @ axes.T
@@ -320,7 +362,7 @@ def _split_polygon(polygons: list[list[int]], u: int, w: int, points) -> list[li
             parts = [polygon[i : j + 1], polygon[j:] + polygon[: i + 1]]
             return polygons[:index] + parts + polygons[index + 1 :]
     where = points[u]
-    raise CuttingError(
+    raise LinesMeetError(
         f"cutting lines cross near ({where[0]:.6g}, {where[1]:.6g}, {where[2]:.6g}): lines must "
         "not cross"
     )

@@ -8,6 +8,17 @@ gap's parameter span is scaled by (mean width / its width)^0.7, a few times, kee
 and take the least number of strips whose equalised width fits the roll: one strip fewer is
 tried too, and does not fit.
 
+A line is every piece of the plane section of its parameter (a plane near a sagging edge cuts the
+surface twice: the corner beyond it is a strip of its own), or the geodesic between the ends of
+that piece. The pieces a gap between two lines leaves are its strips, and the gap is as wide as
+the widest of them. A geodesic that comes closer to the next line's plane than
+``1 − STRAY`` of the way, or touches the boundary between its ends (a geodesic hugs a sagging
+edge), is replaced by its plane section: plane sections of different parameters never meet.
+
+A design mesh is often coarser than the strips: the surface is refined on its own faces first
+(:mod:`vares.geometry.refine`) until no edge is longer than the roll width / ``CELLS_ACROSS``;
+if lines still meet where their crossings were moved onto the same node, it is refined further.
+
 The flattened width is an estimate of the pattern's: :func:`vares.structures.cut.cut` checks the
 patterns themselves and plans again with a narrower target if one is too wide.
 """
@@ -21,18 +32,35 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.cutting import SNAP, CutMesh, cut_mesh
+from ..geometry.cutting import SNAP, CutMesh, LinesMeetError, cut_mesh
 from ..geometry.flatten import lscm
 from ..geometry.line_families import LineFamily, geodesic_between_ends, line_family
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.refine import refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
 from .panels import Panel, split_panels, width_across_warp
 
-__all__ = ["SEAM_KINDS", "StripPlan", "pattern_direction", "plan_strips", "strips_along_lines"]
+__all__ = [
+    "CELLS_ACROSS",
+    "SEAM_KINDS",
+    "STRAY",
+    "StripPlan",
+    "pattern_direction",
+    "plan_strips",
+    "strips_along_lines",
+]
 
 SEAM_KINDS = ("geodesic", "planar")
 #: Equalising iterations per number of strips, and the width ratio that is equal enough.
 _EQUALISE, _EQUAL = 6, 1.005
+#: Cells across a strip of roll width at least (by their longest edges; module docs).
+CELLS_ACROSS = 2
+#: How far a geodesic may stray from its plane: this fraction of the way to the next line's.
+STRAY = 0.4
+#: Pieces of a plane section shorter than this fraction of the roll width are no cutting lines.
+_SHORTEST = 0.1
+#: Further rounds of refinement at most when planned lines meet.
+_RETRIES = 2
 
 
 @dataclass
@@ -43,7 +71,10 @@ class StripPlan:
     ``lines`` the cutting lines as computed (geodesics or plane sections, on the mesh the cut
     started from) and ``warps`` the 3D direction along every strip. ``widths`` are the flattened
     strips' extents across their warps, allowances included (mesh units); ``evaluations`` counts
-    the layouts tried.
+    the layouts tried, ``history`` the widest strip for every number of gaps between lines tried.
+    ``refinements`` is the number of rounds the surface was refined on its own faces before it
+    was cut (``input_cells`` its triangles before, the cut mesh has the rest), and
+    ``replaced_geodesics`` the number of geodesics replaced by their plane sections (module docs).
     """
 
     cut: CutMesh
@@ -53,7 +84,10 @@ class StripPlan:
     widths: list[float]
     family: LineFamily | None = None
     evaluations: int = 0
-    history: list[tuple[int, float]] = field(default_factory=list)  # (strips, widest)
+    history: list[tuple[int, float]] = field(default_factory=list)  # (gaps, widest)
+    refinements: int = 0
+    input_cells: int = 0
+    replaced_geodesics: int = 0
 
 
 def plan_strips(
@@ -72,22 +106,31 @@ def plan_strips(
     """The least number of equally wide strips whose flattened width, with a seam allowance on
     each seam side and ``edge_allowance`` on a side along the surface's boundary, is at most
     ``width`` (mesh units; module docs). ``warp_direction`` (3D) is measured across instead of
-    the direction along each strip."""
+    the direction along each strip. The surface is refined on its own faces where its cells are
+    too large for strips of ``width``."""
     if seams not in SEAM_KINDS:
-        raise ValueError(f"seams must be one of {', '.join(SEAM_KINDS)}; got {seams!r}")
+        raise CuttingError(f"seams must be one of {', '.join(SEAM_KINDS)}; got {seams!r}")
     if not width > 0:
-        raise ValueError(f"the roll width must be > 0; got {width!r}")
+        raise CuttingError(f"the roll width must be > 0; got {width!r}")
     surface = triangulated(mesh)
-    family = line_family(surface, layout, direction)
-
-    def evaluate(spans: np.ndarray) -> StripPlan:
-        plan = _layout(surface, family, spans, seams, snap, warp_direction)
-        plan.widths = _widths(plan, family, seam_allowance, edge_allowance)
-        return plan
-
+    family = line_family(surface, layout, direction)  # of the input: refining keeps the shape
+    input_cells = len(surface.cells["triangle"])
     total = family.span[1] - family.span[0]
+    if not family.closed:  # the whole surface, no line: the number of strips before refining
+        whole = strips_along_lines(surface, [], snap, warp_direction, family)
+        estimate = sum(_widths(whole, family, seam_allowance, edge_allowance)) / width
+        if estimate > max_strips:
+            raise CuttingError(f"more than {max_strips} strips would be needed")
+    refined = _Refined(surface, width)
+
+    def evaluate(spans: np.ndarray) -> tuple[StripPlan, np.ndarray]:
+        plan = refined.layout(family, spans, seams, snap, warp_direction)
+        plan.widths = _widths(plan, family, seam_allowance, edge_allowance)
+        plan.input_cells = input_cells
+        return plan, _gap_widths(plan, family, spans)
+
     smallest = 2 if family.closed else 1
-    first = evaluate(np.full(8, total / 8) if family.closed else np.array([total]))
+    first, _ = evaluate(np.full(8, total / 8) if family.closed else np.array([total]))
     count = max(smallest, math.ceil(sum(first.widths) / width))
     tried: dict[int, StripPlan] = {}
     evaluations, history = 1, []
@@ -96,14 +139,15 @@ def plan_strips(
             raise CuttingError(f"more than {max_strips} strips would be needed")
         spans, plan = np.full(count, total / count), None
         for _ in range(_EQUALISE):
-            candidate = evaluate(spans)
+            candidate, widths = evaluate(spans)
             evaluations += 1
-            widths = np.array(candidate.widths)
             if plan is None or widths.max() < max(plan.widths):
                 plan = candidate
             if widths.max() <= _EQUAL * widths.min():
                 break
-            spans = spans * (widths.mean() / widths) ** 0.7  # damped: widths jump with the mesh
+            # damped (widths jump with the mesh); an empty gap counts as a narrow one
+            widths = np.maximum(widths, 0.1 * widths.max())
+            spans = spans * (widths.mean() / widths) ** 0.7
             spans *= total / spans.sum()
         tried[count] = plan
         history.append((count, max(plan.widths)))
@@ -122,23 +166,137 @@ def plan_strips(
     return plan
 
 
-def _layout(surface, family, spans, seams, snap, warp_direction) -> StripPlan:
-    """Cut along the family's lines at the boundaries of the parameter ``spans``."""
+class _Refined:
+    """The surface the lines are placed on: refined on its own faces until its edges are at most
+    ``width / CELLS_ACROSS`` long, and further (up to ``_RETRIES`` rounds, each halving that
+    length) when planned lines meet; then plane sections in place of geodesics."""
+
+    def __init__(self, surface: SurfaceMesh, width: float) -> None:
+        self.width, self.longest = width, width / CELLS_ACROSS
+        self.surface, self.rounds = refine(surface, self.longest)
+
+    def layout(self, family, spans, seams, snap, warp_direction) -> StripPlan:
+        for retry in range(_RETRIES + 1):
+            try:
+                plan = _layout(self.surface, family, spans, seams, snap, warp_direction, self.width)
+                plan.refinements = self.rounds
+                return plan
+            except LinesMeetError:
+                if retry == _RETRIES and seams == "planar":
+                    raise
+                if retry == _RETRIES:
+                    break
+            self.longest /= 2
+            self.surface, rounds = refine(self.surface, self.longest)
+            self.rounds += rounds
+        plan = _layout(self.surface, family, spans, "planar", snap, warp_direction, self.width)
+        plan.refinements, plan.replaced_geodesics = self.rounds, len(plan.lines)
+        return plan
+
+
+def _bounds(family: LineFamily, spans: np.ndarray) -> np.ndarray:
+    """The parameters of the lines between gaps of parameter ``spans`` (ascending)."""
     bounds = family.span[0] + np.concatenate([[0.0], np.cumsum(spans)])
     if family.closed:
-        bounds = bounds[:-1] + 0.25 * spans[0]
-    else:
-        bounds = bounds[1:-1]
-    sections = []
-    for s in bounds:
-        found = family.sections(surface, float(s))
-        if not found:
-            raise CuttingError(f"a cutting line of parameter {s:.6g} misses the surface")
-        sections.append(max(found, key=lambda line: line.length))
-    base, lines = surface, sections
+        return bounds[:-1] + 0.25 * spans[0]
+    return bounds[1:-1]
+
+
+def _gap_widths(plan: StripPlan, family: LineFamily, spans: np.ndarray) -> np.ndarray:
+    """The width of every gap ``(len(spans),)``: that of the widest strip in it (0 if none)."""
+    bounds = _bounds(family, spans)
+    cells = plan.cut.mesh.cells["triangle"]
+    key = family.parameter(plan.cut.mesh.points[cells].mean(axis=1))
+    out = np.zeros(len(spans))
+    for index, width in enumerate(plan.widths):
+        median = np.median(key[plan.cut.panel_ids == index])
+        gap = int(np.searchsorted(bounds, median, side="right"))
+        if family.closed:
+            gap = (gap - 1) % len(spans)
+        out[gap] = max(out[gap], width)
+    return out
+
+
+def _layout(surface, family, spans, seams, snap, warp_direction, width) -> StripPlan:
+    """Cut along the family's lines at the boundaries of the parameter ``spans``: every piece of
+    each plane section at least ``_SHORTEST`` × ``width`` long, or its geodesic (module docs)."""
+    bounds = _bounds(family, spans)
+    sections, where = [], []
+    for index, s in enumerate(bounds):
+        for line in family.sections(surface, float(s)):
+            if line.length >= _SHORTEST * width:
+                sections.append(line)
+                where.append(index)
+    base, lines, replaced = surface, sections, 0
     if seams == "geodesic" and sections:
-        base, lines = geodesic_between_ends(surface, sections, snap)
-    return strips_along_lines(base, lines, snap, warp_direction, family)
+        base, geodesics = geodesic_between_ends(surface, sections, snap)
+        lines, room, boundary = [], _room(family, bounds), _boundary(base)
+        for section, geodesic, index in zip(sections, geodesics, where, strict=True):
+            s, (below, above) = bounds[index], room[index]
+            if _touches(geodesic, boundary) or _strays(geodesic, family, s, below, above):
+                lines.append(_same_section(family, base, s, section))
+                replaced += 1
+            else:
+                lines.append(geodesic)
+    plan = strips_along_lines(base, lines, snap, warp_direction, family)
+    plan.replaced_geodesics = replaced
+    return plan
+
+
+def _same_section(
+    family: LineFamily, mesh: SurfaceMesh, s: float, section: SurfaceLine
+) -> SurfaceLine:
+    """The piece of the plane section of parameter ``s`` on ``mesh`` (the surface the section
+    was found on, with nodes inserted) that passes through the middle of ``section``."""
+    middle = section.points[len(section.points) // 2]
+
+    def distance(line: SurfaceLine) -> float:
+        return float(np.linalg.norm(line.points - middle, axis=1).min())
+
+    return min(family.sections(mesh, s), key=distance)
+
+
+def _room(family: LineFamily, bounds: np.ndarray) -> list[tuple[float, float]]:
+    """How far (in the parameter) each line may stray below and above its own: ``STRAY`` of
+    the way to the neighbouring lines (unbounded towards the surface's edge)."""
+    period = family.span[1] - family.span[0]
+    if family.closed:
+        below = np.diff(np.concatenate([[bounds[-1] - period], bounds]))
+        above = np.diff(np.concatenate([bounds, [bounds[0] + period]]))
+    else:
+        gaps = np.diff(bounds)
+        below = np.concatenate([[np.inf], gaps])
+        above = np.concatenate([gaps, [np.inf]])
+    return list(zip((STRAY * below).tolist(), (STRAY * above).tolist(), strict=True))
+
+
+def _strays(line: SurfaceLine, family: LineFamily, s: float, below: float, above: float) -> bool:
+    """Whether a line's points between its ends leave the parameters ``[s − below, s + above]``
+    (points on the axis of a radial family, where every line passes, do not count)."""
+    inner = line.points[1:-1]
+    if family.kind == "radial":
+        radius = np.hypot(inner[:, 0] - family.centre[0], inner[:, 1] - family.centre[1])
+        inner = inner[radius > 1e-9 * radius.max(initial=0.0)]
+    if not len(inner):
+        return False
+    offset = family.parameter(inner) - s
+    if family.kind == "radial":
+        offset = np.mod(offset + np.pi, 2 * np.pi) - np.pi
+    return bool(offset.min() < -below or offset.max() > above)
+
+
+def _boundary(mesh: SurfaceMesh) -> tuple[set[int], set[tuple[int, int]]]:
+    edges = mesh.boundary_edges()
+    return set(edges.ravel().tolist()), {tuple(sorted(e)) for e in edges.tolist()}
+
+
+def _touches(line: SurfaceLine, boundary: tuple[set[int], set[tuple[int, int]]]) -> bool:
+    """Whether a line meets the mesh's boundary between its ends."""
+    nodes, edges = boundary
+    for a, b in line.ends[1:-1].tolist():
+        if (a == b and a in nodes) or (a != b and (min(a, b), max(a, b)) in edges):
+            return True
+    return False
 
 
 def strips_along_lines(
