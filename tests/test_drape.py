@@ -467,3 +467,42 @@ def test_drape_ply_takes_its_options_once():
         DrapeOptions(locking_angle=120.0)
     with pytest.raises(OptionsError, match="spacng"):
         drape_ply(mesh, spacng=2.0)
+
+
+def test_pattern_job_drapes_a_ply_beside_the_pattern(tmp_path):
+    from vares.app.job import load_job
+    from vares.io.meshes import write_surface
+
+    mesh = spherical_cap(R, 60.0, 12)
+    surface = tmp_path / "cap.obj"
+    write_surface(surface, mesh)
+    out, job_file = tmp_path / "out", tmp_path / "job.toml"
+    args = ["pattern", surface, "--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
+    args += ["--warp-direction", "1,0,0", "-q"]
+    drape = ["--drape", "--seed", "0,0,100", "--spacing", "2", "--fabric-kind", "woven-plain"]
+    result = run(*args, *drape, "-o", out, "--save-job", job_file)
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "summary.json").read_text())["kinematic_drape"]
+    direct = kinematic_drape(mesh, [0, 0, R], [1, 0, 0], 2.0)
+    expected = producibility(direct.shear_angle, mesh.cell_areas(), 40.0)
+    assert data["producibility"]["warn_fraction"] == pytest.approx(expected.fractions["warn"])
+    assert data["warp"] == [1.0, 0.0, 0.0]  # the pattern's warp direction
+    against = data["against_pattern"]  # the fabric's shear against the net's
+    assert against["correlation"] > 0.9 and against["max_kinematic_shear"] > 20.0
+    written = meshio.read(out / "pattern.vtu")
+    assert np.allclose(
+        written.cell_data["kinematic_shear_angle"][0], direct.shear_angle, equal_nan=True
+    )
+    job = load_job(job_file)
+    assert job.drape is not None and job.drape.fabric_kind == "woven-plain"
+    assert job.drape.seed == (0.0, 0.0, 100.0) and job.drape.spacing == 2.0
+    # a drape flag asks for --drape; a structure is refused
+    alone = run(*args, "--seed", "0,0,100", "-o", tmp_path / "alone")
+    assert alone.exit_code == 2 and "add --drape" in error_line(alone)
+    structure = tmp_path / "structure.toml"
+    structure.write_text(
+        f'[input]\nmesh = "{surface.as_posix()}"\n[material]\nlaw = "neo-hooke"\nE = 1000.0\n'
+        "nu = 0.3\n[structure]\n[drape]\nspacing = 2.0\n"
+    )
+    refused = run("run", structure, "-o", tmp_path / "refused")
+    assert refused.exit_code == 2 and "single surface" in error_line(refused)

@@ -1,6 +1,7 @@
 """The options of a ply's kinematic drape and producibility check, declared once (see
-:mod:`vares.options`): the ``[drape]`` table, the keywords of :func:`vares.analysis.drape.drape_ply`
-and the flags of ``vares drape``."""
+:mod:`vares.options`): the ``[drape]`` table of a job, the keywords of
+:func:`vares.analysis.drape.drape_ply` and the flags of ``vares drape`` (and of ``--drape`` on
+``vares pattern`` and ``vares example``)."""
 
 from __future__ import annotations
 
@@ -25,10 +26,11 @@ class DrapeOptions(Options):
         "Seed point 'x,y,z' on the mould (default: the node nearest the nodes' centroid).",
         section="drape",
     )
-    warp: tuple[float, float, float] = option(
-        (1.0, 0.0, 0.0),
+    warp: tuple[float, float, float] | None = option(
+        None,
         "vector",
-        "Warp direction 'x,y,z' at the seed (projected onto the mould).",
+        "Warp direction 'x,y,z' at the seed, projected onto the mould (default: the pattern's "
+        "warp direction, else x).",
         section="drape",
     )
     spacing: float | None = option(

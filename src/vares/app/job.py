@@ -36,6 +36,10 @@ in :mod:`vares.options`); an unknown table or key is an error naming the closest
     wrinkling = true
     pressure = 0.0
 
+    [drape]                      # present: drape a ply kinematically beside the pattern
+    seed = [0.0, 0.0, 100.0]     # on the surface; the warp is the pattern's warp direction
+    fabric_kind = "woven-twill"  # its locking angle, or: locking_angle = 45.0
+
     [cut]                        # present: cut the surface into strips of roll width
     roll_width = 2.5             # mesh units
     seams = "geodesic"           # or "planar", or "curves" with curves = "lines.3dm"
@@ -53,6 +57,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ..analysis.drape_options import DrapeOptions
 from ..analysis.options import ErectionOptions
 from ..options import Options, OptionsError, Spec, suggest
 from ..solver.options import SolveOptions
@@ -77,16 +82,18 @@ SECTIONS: dict[str, str] = {
     "structure": "structure",
     "cut": "cut",
     "erection": "erection",
+    "drape": "drape",
 }
 #: Tables whose presence means something even when empty.
-_PRESENCE = ("structure", "cut", "erection")
+_PRESENCE = ("structure", "cut", "erection", "drape")
 
 
 @dataclass(frozen=True)
 class Job:
     """A patterning job: one options object per part; ``structure`` is set for a structure of
     several panels, ``cut`` (and ``structure``) for a surface cut into strips of roll width,
-    ``erection`` when the structure is to be erected from its patterns after patterning.
+    ``erection`` when the structure is to be erected from its patterns after patterning,
+    ``drape`` when a ply is draped kinematically beside the pattern (a single surface).
     ``base`` is the folder relative paths are relative to; ``location`` the job file it was
     read from (if any)."""
 
@@ -98,6 +105,7 @@ class Job:
     structure: StructureOptions | None = None
     cut: CutOptions | None = None
     erection: ErectionOptions | None = None
+    drape: DrapeOptions | None = None
     base: Path = field(default_factory=Path.cwd)
     location: Path | None = None
 
@@ -187,6 +195,7 @@ _PARTS: dict[str, type[Options]] = {
     "structure": StructureOptions,
     "cut": CutOptions,
     "erection": ErectionOptions,
+    "drape": DrapeOptions,
 }
 
 

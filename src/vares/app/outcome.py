@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..analysis.compensation import CompensationReport
 from ..analysis.erection import ErectionResult
@@ -16,13 +17,17 @@ from ..units import unit_factor
 from .job import Job
 from .sections import STRUCTURE_MARK_SPACING
 
+if TYPE_CHECKING:  # a drape is made (and its module imported) only when a job asks for one
+    from ..analysis.drape import PlyDrape
+
 __all__ = ["JobOutcome", "PanelOutcome"]
 
 
 @dataclass
 class PanelOutcome:
     """One pattern of a job: the panel's name, mesh and result, its compensation report (for a
-    converged solve), its warnings and the files written for it (in ``directory``)."""
+    converged solve), its warnings, the files written for it (in ``directory``) and the ply's
+    kinematic drape (when the job asks for one)."""
 
     name: str
     mesh: SurfaceMesh
@@ -32,6 +37,7 @@ class PanelOutcome:
     units: str = "m"
     warnings: list[str] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
+    drape: PlyDrape | None = None
 
 
 @dataclass

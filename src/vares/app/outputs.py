@@ -170,6 +170,13 @@ def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | No
         data["job_digest"] = job.digest()
     if panel.compensation is not None:
         data["compensation"] = panel.compensation.to_dict()
+    if panel.drape is not None:
+        shear = result.fields["shear_angle"] if result.converged else None
+        data["kinematic_drape"] = panel.drape.summary() | (
+            {}
+            if shear is None
+            else {"against_pattern": panel.drape.comparison(shear, panel.mesh.cell_areas())}
+        )
     _write(panel, "summary.json", lambda p: write_json(p, data))
 
 
@@ -202,14 +209,13 @@ def _write_pattern_files(
 ) -> None:
     result, mesh = panel.result, panel.mesh
     x = result.material_coordinates
+    fields = result.fields | ({} if panel.drape is None else panel.drape.fields())
     _write(panel, "pattern.obj", lambda p: write_surface(p, mesh, x, units=panel.units))
-    _write(
-        panel, "pattern.vtu", lambda p: write_surface(p, mesh, x, result.fields, units=panel.units)
-    )
+    _write(panel, "pattern.vtu", lambda p: write_surface(p, mesh, x, fields, units=panel.units))
     _write(
         panel,
         "surface.vtu",
-        lambda p: write_surface(p, mesh, fields=result.fields, units=panel.units),
+        lambda p: write_surface(p, mesh, fields=fields, units=panel.units),
     )
     if dxf:
         _write_dxf(panel, job, marks, cut)

@@ -60,6 +60,8 @@ def run_job(
     write the job as TOML there (paths relative to it). ``on_solve_start`` is told the name,
     mesh (the first panel's) and material before solving.
     """
+    if job.drape is not None and job.structure is not None:
+        raise JobError("[drape] drapes a ply on a single surface, not on a structure's panels")
     material = job.material.build(job.base)
     source = load_input(job)
     check_mark_spacing(job, source)
@@ -289,13 +291,13 @@ def _solve_one(job, source: Input, material, options, callback) -> JobOutcome:
         callback=callback,
         initial_guess=source.initial_pattern,
     )
-    return JobOutcome(
-        job,
-        material,
-        [_panel(job, source, panel.name, panel.mesh, result)],
-        units=source.units,
-        repairs=source.repairs,
-    )
+    patterned = _panel(job, source, panel.name, panel.mesh, result)
+    if job.drape is not None:
+        from ..analysis.drape import drape_ply
+
+        warp = job.solve.warp_direction or (1.0, 0.0, 0.0)
+        patterned.drape = drape_ply(panel.mesh, job.drape, warp_direction=warp)
+    return JobOutcome(job, material, [patterned], units=source.units, repairs=source.repairs)
 
 
 def _solve_structure(job, source: Input, material, options, callback) -> JobOutcome:

@@ -16,6 +16,7 @@ from typing import Annotated, Any
 
 import typer
 
+from ...analysis.drape_options import DrapeOptions
 from ...analysis.options import ErectionOptions
 from ...options import Options, OptionsError, Spec
 from ...solver.options import SolveOptions
@@ -233,6 +234,35 @@ def erection_from_flags(values: dict[str, Any], *, erect: bool) -> ErectionOptio
     return None
 
 
+#: ``--drape``: drape a ply kinematically beside the pattern (a single surface).
+DRAPE_FLAG = [
+    option_parameter(
+        "drape",
+        False,
+        bool,
+        "--drape",
+        help="Drape a ply kinematically beside the pattern: its shear and producibility in "
+        "summary.json and the VTU files (see 'vares drape').",
+        panel=PANELS["drape"],
+    )
+]
+#: The drape options' flags (its warp is the pattern's --warp-direction).
+DRAPE_FLAGS = flags(DrapeOptions, exclude=("warp",))
+
+
+def drape_from_flags(values: dict[str, Any], *, drape: bool) -> DrapeOptions | None:
+    """The drape options the flags describe, or None without ``drape``; a drape flag given
+    without it is an error."""
+    options = build(DrapeOptions, values)
+    if drape:
+        return options
+    changed = [n for n, d in DrapeOptions.defaults().items() if getattr(options, n) != d]
+    if changed:
+        flag = flag_name(changed[0], DrapeOptions.specs()[changed[0]])
+        raise InputError(f"{flag} is a drape option: add --drape")
+    return None
+
+
 def _prestress(values: dict[str, Any]) -> dict[str, Any]:
     given, field = values.get("prestress"), values.get("prestress_field")
     if given is not None and field is not None:
@@ -305,5 +335,6 @@ def job_from_flags(
         output=build(OutputOptions, values),
         structure=build(StructureOptions, values) if structure else None,
         erection=erection_from_flags(values, erect=values.get("erect", False)),
+        drape=drape_from_flags(values, drape=values.get("drape", False)),
         base=Path.cwd(),
     )

@@ -8,7 +8,15 @@ import typer
 from ...geometry.examples import EXAMPLES
 from ..sections import InputOptions
 from .common import execute, guarded
-from .flags import JOB_FLAGS, flags, job_from_flags, option_parameter, with_flags
+from .flags import (
+    DRAPE_FLAG,
+    DRAPE_FLAGS,
+    JOB_FLAGS,
+    flags,
+    job_from_flags,
+    option_parameter,
+    with_flags,
+)
 
 __all__ = ["example", "pattern"]
 
@@ -36,7 +44,13 @@ RUN_FLAGS = [
 ]
 
 
-@with_flags(flags(InputOptions, exclude=("cell_type", "panel_field")), JOB_FLAGS, RUN_FLAGS)
+@with_flags(
+    flags(InputOptions, exclude=("cell_type", "panel_field")),
+    JOB_FLAGS,
+    DRAPE_FLAG,
+    DRAPE_FLAGS,
+    RUN_FLAGS,
+)
 def pattern(
     input: Annotated[Path, typer.Argument(help="Surface mesh (OBJ, STL, PLY, VTU, Gmsh, 3dm, …).")],
     **values: Any,
@@ -54,7 +68,9 @@ def pattern(
     guarded(body)
 
 
-@with_flags(flags(InputOptions, exclude=("panel_field",)), JOB_FLAGS, RUN_FLAGS)
+@with_flags(
+    flags(InputOptions, exclude=("panel_field",)), JOB_FLAGS, DRAPE_FLAG, DRAPE_FLAGS, RUN_FLAGS
+)
 def example(
     example_name: Annotated[
         str, typer.Argument(metavar="NAME", help="Example: " + ", ".join(EXAMPLES))
