@@ -186,7 +186,7 @@ def test_read_mesh_drops_unused_nodes_with_a_warning(tmp_path):
     [
         (b"", "is empty"),
         (b"solid x\nfacet normal 0 0 1\n  outer loop\n vertex 0 0", "cannot read"),
-        (b"\x00\x01\x02garbage", "cannot read"),
+        (b"\x00\x01\x02garbage", "is not an STL file: it is binary and 10 bytes long"),
     ],
 )
 def test_read_mesh_bad_files(tmp_path, content, message):

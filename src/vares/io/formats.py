@@ -186,14 +186,18 @@ def check_stl(path: Path) -> None:
     if announced is not None and size == 84 + 50 * announced:
         return  # binary
     data = Path(path).read_bytes()
-    binary = b"\x00" in data[:4096]
-    if data.removeprefix(b"\xef\xbb\xbf").lstrip()[:5].lower() != b"solid" or binary:
-        if binary and announced is not None:
+    if b"\x00" in data[:4096]:  # binary, whether or not its header begins with "solid"
+        if announced is None:
             raise MeshError(
-                f"{path} is not an STL file: a binary STL of the {announced} triangles its "
-                f"header announces has 84 + 50·{announced} = {84 + 50 * announced} bytes, this "
-                f"file has {size} (cut short, or another format)"
+                f"{path} is not an STL file: it is binary and {size} bytes long, less than the "
+                "84 bytes of a binary STL's header"
             )
+        raise MeshError(
+            f"{path} is not an STL file: a binary STL of the {announced} triangles its header "
+            f"announces has 84 + 50·{announced} = {84 + 50 * announced} bytes, this file has "
+            f"{size} (cut short, or another format)"
+        )
+    if data.removeprefix(b"\xef\xbb\xbf").lstrip()[:5].lower() != b"solid":
         lines = data.decode("utf-8", errors="replace").splitlines()
         vertices = sum(1 for line in lines if line.startswith("v "))
         faces = sum(1 for line in lines if line.startswith("f "))
@@ -205,11 +209,6 @@ def check_stl(path: Path) -> None:
         raise MeshError(
             f"{path} is not an STL file: an ASCII STL begins with 'solid', a binary one is "
             "84 + 50·n bytes for its n triangles"
-        )
-    if binary:
-        raise MeshError(
-            f"{path} is not an STL file: it begins with 'solid' as an ASCII STL does but holds "
-            "binary data, and its size fits no binary STL"
         )
     stray = _NOT_STL_LINE.search(data, data.find(b"\n") + 1 or size)  # after "solid name"
     if stray is not None:
