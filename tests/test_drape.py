@@ -480,8 +480,10 @@ def test_pattern_job_drapes_a_ply_beside_the_pattern(tmp_path):
     args = ["pattern", surface, "--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
     args += ["--warp-direction", "1,0,0", "-q"]
     drape = ["--drape", "--seed", "0,0,100", "--spacing", "2", "--fabric-kind", "woven-plain"]
-    result = run(*args, *drape, "-o", out, "--save-job", job_file)
+    result = run(*args, *drape, "-o", out, "--save-job", job_file, "--report")
     assert result.exit_code == 0, result.stderr
+    report = (out / "report.html").read_text()
+    assert "Kinematic drape and producibility" in report and "figure-drape-shear" in report
     data = json.loads((out / "summary.json").read_text())["kinematic_drape"]
     direct = kinematic_drape(mesh, [0, 0, R], [1, 0, 0], 2.0)
     expected = producibility(direct.shear_angle, mesh.cell_areas(), 40.0)

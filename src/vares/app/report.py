@@ -6,7 +6,7 @@ directions, the result fields on the pattern and on the 3D surface, the key figu
 warnings. A structure gets one more, for the whole: its panels, its seams before and after
 matching, and links to the panels' reports. A job that erects its structure adds the erection
 section (:mod:`vares.app.erection_report`) to the pattern's report (the structure's, for a
-structure).
+structure); one that drapes a ply, the drape's (:mod:`vares.app.drape_report`).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from ..io.files import write_text
 from ..materials import Hyperelastic
 from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS
 from ..solver.linear import solver_choice
+from .drape_report import drape_section
 from .erection_report import erection_section
 from .html_parts import (
     REPORT_DPI,
@@ -253,6 +254,7 @@ def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
     parts += _convergence_section(result)
     if result.converged or result.uncuttable:
         parts += _pattern_figures(panel, material)
+    parts += drape_section(panel)
     if outcome.erection is not None and outcome.structure is None:
         parts += erection_section(outcome.erection, outcome.units, outcome.directory / "erect")
     files = [(f.name, os.path.relpath(f, panel.directory)) for f in panel.files]
