@@ -175,3 +175,21 @@ def test_superlu_frees_its_factors_before_making_the_next(monkeypatch):
     assert held_at_next == [False]
     rhs = np.ones(n)
     np.testing.assert_allclose(2.0 * matrix @ solver.solve(rhs), rhs, rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", available_solvers())
+def test_two_solvers_factorise_and_solve_in_turn(name):
+    """A solver keeps its own factors whatever other solvers do in between (PARDISO's solvers
+    share one handle: a solver whose factors were replaced factorises its matrix again)."""
+    rng = np.random.default_rng(1)
+    matrices = []
+    for size in (30, 40):
+        a = sp.random(size, size, density=0.2, random_state=rng)
+        matrices.append((a @ a.T + size * sp.identity(size)).tocsr())
+    solvers = [get_solver(name) for _ in matrices]
+    for solver, matrix in zip(solvers, matrices, strict=True):
+        solver.factorize(matrix)
+    for _ in range(2):
+        for solver, matrix in zip(solvers, matrices, strict=True):
+            rhs = rng.normal(size=matrix.shape[0])
+            np.testing.assert_allclose(matrix @ solver.solve(rhs), rhs, atol=1e-10)

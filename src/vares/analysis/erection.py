@@ -77,6 +77,9 @@ class ErectionResult:
     panels, node_maps, cell_ids
         Panel names; per panel, the welded node of each of its nodes and the welded cell of each
         of its cells (its own cell order).
+    problem, structure, context
+        The forward problem, the welded structure and the Newton context it was solved with
+        (what the sensitivities of :mod:`vares.analysis.erection_optimum` build on).
     """
 
     mesh: SurfaceMesh
@@ -103,6 +106,9 @@ class ErectionResult:
     panels: list[str] = field(default_factory=list)
     node_maps: list[np.ndarray] = field(default_factory=list)
     cell_ids: list[np.ndarray] = field(default_factory=list)
+    problem: ErectionProblem | None = field(default=None, repr=False, compare=False)
+    structure: Structure | None = field(default=None, repr=False, compare=False)
+    context: NewtonContext | None = field(default=None, repr=False, compare=False)
 
     @property
     def iterations(self) -> int:
@@ -267,6 +273,9 @@ def erect(
         panels=structure.names,
         node_maps=structure.welded.node_maps,
         cell_ids=structure.panel_cells,
+        problem=problem,
+        structure=structure,
+        context=ctx,
     )
 
 

@@ -75,6 +75,42 @@ class ErectionOptions(Options):
         minimum=1,
     )
 
+    optimise: bool = option(
+        False,
+        "bool",
+        "Optimise the patterns for the erected structure: change them so that it carries the "
+        "intended prestress and keeps the design's shape (seams kept matched), starting from "
+        "the VaReS patterns.",
+        section="erection",
+        flags=("--optimise/--no-optimise",),
+    )
+    shape_weight: float = option(
+        0.1,
+        "float",
+        "With --optimise: the weight of the erected shape's RMS deviation from the design "
+        "against the RMS deviation of the forces from the intended, each relative to the VaReS "
+        "patterns' erection.",
+        section="erection",
+        minimum=0,
+    )
+    shape_bound: float | None = option(
+        1.5,
+        "float",
+        "With --optimise: the largest deviation from the design allowed, relative to the VaReS "
+        "patterns' erection (a node beyond it is penalised heavily; none in the API: no bound).",
+        section="erection",
+        positive=True,
+        optional=True,
+    )
+    optimise_iterations: int = option(
+        8,
+        "int",
+        "With --optimise: at most this many steps of the optimiser (each one erection and one "
+        "least-squares solve).",
+        section="erection",
+        minimum=1,
+    )
+
     def check(self) -> None:
         if self.pressure and self.cable_stiffness is not None:
             raise OptionsError(

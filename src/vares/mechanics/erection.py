@@ -179,11 +179,16 @@ class ErectionProblem:
         return respond
 
     def evaluate(
-        self, x: np.ndarray, order: int = 2, relaxed: bool | None = None
+        self,
+        x: np.ndarray,
+        order: int = 2,
+        relaxed: bool | None = None,
+        stabilised: bool = True,
     ) -> ErectionEvaluation:
         """Energy (and per-block gradients for ``order ≥ 1``, Hessians for ``order = 2``) at the
         positions ``x`` ``(n, 3)``; ``relaxed``: the tension-field or the plain law (default
-        :attr:`wrinkling`)."""
+        :attr:`wrinkling`); ``stabilised``: the film's stiffness in the Hessians (module docs),
+        else the exact ones."""
         energies, gradients, hessians, jacobian_hessians = [], [], [], []
         total = 0.0
         for index, block in enumerate(self.blocks):
@@ -193,7 +198,7 @@ class ErectionProblem:
             energies.append(result.energy)
             total += np.sum(result.energy).real
             gradient, hessian = result.gradient, result.hessian
-            if hessian is not None and self._film is not None:
+            if hessian is not None and self._film is not None and stabilised:
                 hessian = hessian + self._film[index]
             if self.pressure:
                 load = pressure_terms(nodes, self.pressure, order)

@@ -234,13 +234,28 @@ class PardisoSolver:
             self._solver.iparm[1] = 3 if size > NESTED_DISSECTION_ABOVE else 0  # iparm(2)
             self._phase(11, empty)
             _PARDISO_ANALYSED = _pattern(self._matrix)
+        self._numeric()
+
+    def _numeric(self) -> None:
+        """The numeric factorisation of this solver's matrix into the shared handle."""
+        global _PARDISO_FACTORS
+        empty = np.zeros(self._matrix.shape[0])
         self._phase(22, empty)
+        _PARDISO_FACTORS = self
         if self._solver.iparm[29] != 0:  # iparm(30): a zero pivot
             raise SingularMatrixError("PARDISO found a zero pivot")
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         if self._matrix is None:
             raise RuntimeError("factorize() must be called before solve()")
+        if _PARDISO_FACTORS is not self:  # another solver factorised since: factorise again
+            global _PARDISO_ANALYSED
+            analysed = _PARDISO_ANALYSED
+            if analysed is None or not _same_pattern(analysed, _pattern(self._matrix)):
+                self._solver.iparm[1] = 3 if self._matrix.shape[0] > NESTED_DISSECTION_ABOVE else 0
+                self._phase(11, np.zeros(self._matrix.shape[0]))
+                _PARDISO_ANALYSED = _pattern(self._matrix)
+            self._numeric()
         return _finite(self._phase(33, np.ascontiguousarray(rhs, dtype=float)))
 
 
@@ -289,6 +304,9 @@ NESTED_DISSECTION_ABOVE = 600_000
 
 #: The sparsity pattern the shared PARDISO handle has analysed (see :func:`_pattern`).
 _PARDISO_ANALYSED: tuple | None = None
+#: The solver whose numeric factors the shared handle holds (a solver whose matrix was
+#: factorised by another since factorises it again before it solves).
+_PARDISO_FACTORS: PardisoSolver | None = None
 
 
 def _pattern(matrix: sp.csr_matrix) -> tuple:

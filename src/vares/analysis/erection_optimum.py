@@ -1,0 +1,588 @@
+"""Patterns optimised for the structure they build.
+
+VaReS minimises the energy of erecting the pattern *onto the design shape*. The structure the
+patterns make settles elsewhere (:func:`vares.erect`): its forces differ from the intended
+prestress and its shape from the design. Here the patterns ``X`` are changed so that the erected
+equilibrium ``x*(X)`` (``R(x*, X) = 0``) carries the intended prestress and keeps the design's
+shape, by least squares:
+
+    J(X) = Σ_cells A_e Σ_yarn (n(x*, X) − n_intended)² / (A s₀²)
+           + w Σ_nodes a_i d_i(x*)² / (A d₀²)
+           + Σ_seams (ℓ_P(X) − ℓ_Q(X))² / (A_seam h²)
+
+``n`` the membrane forces along warp and fill, ``d`` the normal deviation from the design, ``A_e``
+and ``a_i`` the cells' and nodes' design areas, ``s₀`` and ``d₀`` the RMS force deviation and RMS
+shape deviation of the starting patterns' erection (so ``J`` starts at ``1 + w`` and
+``shape_weight`` ``w`` weighs a relative gain in shape against one in force), and the last term
+keeps every seam equally long in the two patterns it joins (``ℓ`` the lengths of a welded seam
+edge in each, ``h`` a strain of 1e-6 of the edge's design length: a soft but stiff constraint).
+
+The minimisation is Levenberg–Marquardt (a Gauss–Newton model of ``J``, damped by ``μ``; a step
+is taken only if ``J`` falls, ``μ`` follows the ratio of the actual to the predicted decrease).
+Its Jacobian is never formed: products with it and its transpose take one solve each with the
+erection's tangent ``K`` (factorised once per iteration), ``dx* = −K⁻¹ (∂R/∂X) dX`` and the
+adjoint ``Jᵀu = ∂r/∂Xᵀ u − (∂R/∂X)ᵀ K⁻¹ ∂r/∂xᵀ u`` (:mod:`vares.analysis.erection_sensitivity`),
+and LSQR solves each step's least-squares problem. It stops when a step lowers ``J`` by less than
+``tolerance`` of it, or after ``iterations`` steps. Patterns stay one-to-one (a step that inverts
+a pattern cell is refused like one that raises ``J``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..materials import Hyperelastic
+from ..mechanics.problem import Problem
+from ..options import split_settings, takes_options
+from ..solver.linear import get_solver
+from ..solver.options import SolveOptions
+from ..solver.result import PatternResult
+from .erection import ErectionResult, erect
+from .erection_fields import node_normals
+from .erection_model import Pattern, patterns_of
+from .erection_sensitivity import block_derivatives
+from .options import ErectionOptions
+
+__all__ = ["OptimisedPatterns", "OptimumRecord", "optimise_for_erection", "optimised_results"]
+
+#: The first damping ``μ``, relative to ``|J|²``; it follows the gain ratio (Nielsen's rule).
+INITIAL_DAMPING = 1e-3
+#: No step changes a pattern edge's length by more than this strain.
+MAX_STEP_STRAIN = 0.02
+#: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
+LSQR_TOLERANCE = 1e-4
+LSQR_LIMIT = 60
+#: Seam edges are matched again after every step until their lengths differ by at most this
+#: fraction of the patterns' size (at most MATCH_STEPS Gauss–Newton steps).
+MATCHED = 1e-13
+MATCH_STEPS = 5
+#: Deviations are measured against the start's, but at least against a force of this strain
+#: times the stiffness and a length of 1e-3 of it times the size; deviations below these are
+#: round-off, nothing is left to gain.
+FLOOR = 1e-8
+#: The weight of each yarn's mean force deviation against the per-cell deviations (the mean
+#: is held to the intended: a uniformly higher tension would lower the shape deviation).
+MEAN_WEIGHT = 100.0
+#: The weight of a node's shape deviation beyond the bound, against the RMS terms.
+BOUND_WEIGHT = 100.0
+
+
+@dataclass(frozen=True)
+class OptimumRecord:
+    """One iteration: the objective ``J`` and its force and shape parts, the erected RMS force
+    deviation, the largest and RMS shape deviation, the largest seam mismatch (length units),
+    the damping ``μ``, LSQR's iterations and whether the step was taken."""
+
+    iteration: int
+    objective: float
+    force_part: float
+    shape_part: float
+    force_rms: float
+    deviation_max: float
+    deviation_rms: float
+    seam_mismatch: float
+    damping: float
+    lsqr_iterations: int
+    accepted: bool
+
+
+@dataclass
+class OptimisedPatterns:
+    """The optimised patterns (one :class:`Pattern` per panel, as given), the erections of the
+    starting and of the optimised patterns, the iterations and why it stopped."""
+
+    patterns: list[Pattern]
+    start: ErectionResult
+    erected: ErectionResult
+    history: list[OptimumRecord]
+    converged: bool
+    reason: str | None
+    shape_weight: float
+    elapsed: float = 0.0
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def iterations(self) -> int:
+        return sum(1 for r in self.history if r.iteration > 0)
+
+
+class _Layout:
+    """Where each pattern coordinate and erected force lives: the variables are the patterns'
+    nodes, panel after panel (``offsets``); per membrane block its panel and panel-local cells."""
+
+    def __init__(self, patterns: list[Pattern], erected: ErectionResult) -> None:
+        counts = [p.mesh.num_points for p in patterns]
+        self.offsets = np.concatenate([[0], np.cumsum(counts)])
+        self.num_variables = 2 * int(self.offsets[-1])
+        self.block_cells = []  # panel-local node ids of each block's cells
+        for p, pattern in enumerate(patterns):
+            for cells in pattern.mesh.cells.values():
+                self.block_cells.append(self.offsets[p] + cells)
+        self.cell_ids = erected.structure.block_cells
+
+    def split(self, vector: np.ndarray) -> list[np.ndarray]:
+        flat = vector.reshape(-1, 2)
+        return [flat[a:b] for a, b in zip(self.offsets[:-1], self.offsets[1:], strict=True)]
+
+
+def _seam_edges(patterns: list[Pattern], erected: ErectionResult, layout: _Layout) -> np.ndarray:
+    """Welded seam edges as pairs of pattern edges ``(k, 2, 2)`` (variable node ids): boundary
+    edges of two panels that weld onto one edge of the structure."""
+    found: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for p, (pattern, node_map) in enumerate(zip(patterns, erected.node_maps, strict=True)):
+        for a, b in pattern.mesh.boundary_edges():
+            key = (min(node_map[a], node_map[b]), max(node_map[a], node_map[b]))
+            found.setdefault(key, []).append((layout.offsets[p] + a, layout.offsets[p] + b))
+    pairs = [v[:2] for v in found.values() if len(v) >= 2]
+    return np.array(pairs, dtype=int).reshape(-1, 2, 2)
+
+
+def seam_constraints(X: np.ndarray, seams: np.ndarray, num_variables: int):
+    """``c = ℓ_P − ℓ_Q`` per seam edge (its lengths in the two patterns it joins, ``X`` all
+    patterns' nodes ``(N, 2)``) and the Jacobian ``(k, num_variables)``."""
+    if not len(seams):
+        return np.zeros(0), sp.csr_matrix((0, num_variables))
+    ends = X[seams]  # (k, 2 sides, 2 ends, 2)
+    vectors = ends[:, :, 1] - ends[:, :, 0]  # (k, 2, 2)
+    lengths = np.linalg.norm(vectors, axis=-1)  # (k, 2)
+    units = vectors / lengths[..., None]  # d length / d end = ±unit
+    rows, cols, vals = [], [], []
+    for side, sign in ((0, 1.0), (1, -1.0)):
+        for end, direction in ((0, -1.0), (1, 1.0)):
+            for axis in range(2):
+                rows.append(np.arange(len(lengths)))
+                cols.append(2 * seams[:, side, end] + axis)
+                vals.append(sign * direction * units[:, side, axis])
+    jac = sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(len(lengths), num_variables),
+    )
+    return lengths[:, 0] - lengths[:, 1], jac
+
+
+def _matched(patterns: list[Pattern], seams: np.ndarray, layout: _Layout) -> list[Pattern]:
+    """The patterns moved least (Gauss–Newton, minimum norm) to make every seam edge equally
+    long in its two patterns, to round-off."""
+    if not len(seams):
+        return patterns
+    X = np.concatenate([p.material_coordinates for p in patterns])
+    size = float(np.ptp(X, axis=0).max())
+    for _ in range(MATCH_STEPS):
+        c, C = seam_constraints(X, seams, layout.num_variables)
+        if np.abs(c).max() <= MATCHED * size:
+            break
+        gram = spla.splu((C @ C.T).tocsc())
+        X = X - (C.T @ gram.solve(c)).reshape(-1, 2)
+    return _moved(
+        patterns,
+        layout.split((X - np.concatenate([p.material_coordinates for p in patterns])).ravel()),
+    )
+
+
+class _Model:
+    """The residual vector of ``J`` at one erected state and products with its Jacobian."""
+
+    def __init__(
+        self,
+        patterns: list[Pattern],
+        erected: ErectionResult,
+        layout: _Layout,
+        seams: np.ndarray,
+        scales: tuple[float, float],
+        shape_weight: float,
+        shape_bound: float | None,
+        linear_solver: str | None,
+    ) -> None:
+        self.erected, self.layout, self.seams = erected, layout, seams
+        problem, ctx = erected.problem, erected.context
+        x = erected.erected_points
+        mesh = erected.mesh
+        area = mesh.cell_areas()
+        total = area.sum()
+        force_scale, shape_scale = scales
+        n_cells, n_nodes = mesh.num_cells, mesh.num_points
+        # forces and their derivatives, block by block
+        forces = np.zeros((n_cells, 2))
+        mixed_rows, mixed_cols, mixed_vals = [], [], []
+        fx_rows, fx_cols, fx_vals = [], [], []
+        fX_rows, fX_cols, fX_vals = [], [], []
+        for k, block in enumerate(problem.blocks):
+            d = block_derivatives(problem, k, x)
+            ids = layout.cell_ids[k]
+            forces[ids] = d.forces
+            nen = block.cells.shape[1]
+            xdof = 3 * block.cells[:, :, None] + np.arange(3)  # (m, nen, 3)
+            Xdof = 2 * layout.block_cells[k][:, :, None] + np.arange(2)  # (m, nen, 2)
+            mixed_rows.append(np.broadcast_to(xdof[:, :, :, None, None], d.mixed.shape).ravel())
+            mixed_cols.append(np.broadcast_to(Xdof[:, None, None], d.mixed.shape).ravel())
+            mixed_vals.append(d.mixed.ravel())
+            frow = 2 * ids[:, None] + np.arange(2)  # (m, 2)
+            shape_x = (len(ids), 2, nen, 3)
+            fx_rows.append(np.broadcast_to(frow[:, :, None, None], shape_x).ravel())
+            fx_cols.append(np.broadcast_to(xdof[:, None], shape_x).ravel())
+            fx_vals.append(d.force_by_x.ravel())
+            shape_X = (len(ids), 2, nen, 2)
+            fX_rows.append(np.broadcast_to(frow[:, :, None, None], shape_X).ravel())
+            fX_cols.append(np.broadcast_to(Xdof[:, None], shape_X).ravel())
+            fX_vals.append(d.force_by_X.ravel())
+        nv = layout.num_variables
+        cat = np.concatenate
+        mixed = sp.csr_matrix(
+            (cat(mixed_vals), (cat(mixed_rows), cat(mixed_cols))), shape=(3 * n_nodes, nv)
+        )
+        free = ctx.assembler.free
+        self.mixed = mixed[free]
+        raw_x = sp.csr_matrix(
+            (cat(fx_vals), (cat(fx_rows), cat(fx_cols))), shape=(2 * n_cells, 3 * n_nodes)
+        ).tocsc()[:, np.flatnonzero(free)]
+        raw_X = sp.csr_matrix((cat(fX_vals), (cat(fX_rows), cat(fX_cols))), shape=(2 * n_cells, nv))
+        # per cell and yarn the force deviation, and per yarn its mean (held near zero)
+        force_weight = np.repeat(np.sqrt(area / total), 2) / force_scale
+        mean_rows = sp.csr_matrix(
+            (
+                np.tile(area / total, 2) * np.sqrt(MEAN_WEIGHT) / force_scale,
+                (
+                    np.repeat([0, 1], n_cells),
+                    np.concatenate([2 * np.arange(n_cells) + k for k in (0, 1)]),
+                ),
+            ),
+            shape=(2, 2 * n_cells),
+        )
+        rows_of = sp.vstack([sp.diags(force_weight), mean_rows]).tocsr()
+        self.by_x = rows_of @ raw_x
+        self.by_X = rows_of @ raw_X
+        force_residual = rows_of @ (forces - erected.intended).ravel()
+        # shape: the normal deviation at every node (its derivative the normal itself), and
+        # where it exceeds the bound, the excess
+        normals, node_area = node_normals(mesh)
+        d = erected.normal_deviation
+        rms_weight = np.sqrt(shape_weight * node_area / total) / shape_scale
+        over = np.zeros(n_nodes)
+        if shape_bound is not None:
+            active = np.abs(d) > shape_bound
+            over[active] = np.sqrt(BOUND_WEIGHT * node_area[active] / total) / shape_scale
+        excess = over * (np.abs(d) - (shape_bound or 0.0))
+        weights = np.concatenate([rms_weight, over * np.sign(d)])
+        rows = np.repeat(np.arange(2 * n_nodes), 3)
+        shape_by_x = sp.csr_matrix(
+            (
+                (weights[:, None] * np.vstack([normals, normals])).ravel(),
+                (rows, np.tile(np.arange(3 * n_nodes), 2)),
+            ),
+            shape=(2 * n_nodes, 3 * n_nodes),
+        ).tocsc()[:, np.flatnonzero(free)]
+        shape_residual = np.concatenate([rms_weight * d, excess])
+        self.by_x = sp.vstack([self.by_x, shape_by_x]).tocsr()
+        # seams: the two lengths of every seam edge, equal
+        self.seam_residual, self.seam_by_X = self._seams(patterns)
+        self.residual = np.concatenate([force_residual, shape_residual])
+        self.parts = (
+            float(force_residual @ force_residual),
+            float(shape_residual @ shape_residual),
+        )
+        self.forces = forces
+        self.num_force, self.num_shape = len(force_residual), len(shape_residual)
+        solver = get_solver(linear_solver)
+        # the exact tangent where every cell is taut; the film keeps it definite where cells
+        # wrinkle (their positions then have no determinate derivative across the wrinkles)
+        taut = not erected.fields["state"].any()
+        evaluation = problem.evaluate(x, order=2, stabilised=not taut)
+        solver.factorize(ctx.assembler.matrix(evaluation.hessians))
+        self.solver = solver
+        self.solves = 0
+
+    def _seams(self, patterns: list[Pattern]):
+        """The seam constraints ``c = ℓ_P − ℓ_Q`` (one per seam edge) and their Jacobian."""
+        X = np.concatenate([p.material_coordinates for p in patterns])
+        return seam_constraints(X, self.seams, self.layout.num_variables)
+
+    def _tangent_solve(self, rhs: np.ndarray) -> np.ndarray:
+        self.solves += 1
+        return self.solver.solve(rhs)
+
+    def matvec(self, v: np.ndarray) -> np.ndarray:
+        """``J v``: the residuals' change for a change ``v`` of the patterns."""
+        dx = -self._tangent_solve(self.mixed @ v)
+        forces = self.by_X @ v + self.by_x[: self.num_force] @ dx
+        shape = self.by_x[self.num_force :] @ dx
+        return np.concatenate([forces, shape])
+
+    def rmatvec(self, u: np.ndarray) -> np.ndarray:
+        """``Jᵀ u`` by the adjoint of the erected equilibrium."""
+        nf, ns = self.num_force, self.num_shape
+        adjoint = self._tangent_solve(self.by_x.T @ u[: nf + ns])
+        return self.by_X.T @ u[:nf] - self.mixed.T @ adjoint
+
+    def operator(self) -> spla.LinearOperator:
+        """``J P``: the Jacobian on the steps that keep the seams matched to first order."""
+        shape = (len(self.residual), self.layout.num_variables)
+        if not len(self.seams):
+            return spla.LinearOperator(shape, matvec=self.matvec, rmatvec=self.rmatvec)
+        project = self.projection()
+        return spla.LinearOperator(
+            shape,
+            matvec=lambda v: self.matvec(project(v)),
+            rmatvec=lambda u: project(self.rmatvec(u)),
+        )
+
+    def projection(self):
+        """``P = I − Cᵀ (C Cᵀ)⁻¹ C`` onto the null space of the seam constraints' Jacobian."""
+        if getattr(self, "_projection", None) is None:
+            C = self.seam_by_X.tocsr()
+            gram = spla.splu((C @ C.T).tocsc())
+            self._gram = gram
+            self._projection = lambda v: v - C.T @ gram.solve(C @ v)
+        return self._projection
+
+
+def _erect(patterns, material, thickness, solver, options, start):
+    return erect(patterns, material, thickness, solver=solver, options=options, start=start)
+
+
+def _rms(result: ErectionResult) -> float:
+    stats = result.statistics()["stress"]
+    return float(np.hypot(stats["warp"]["rms_deviation"], stats["fill"]["rms_deviation"]))
+
+
+@takes_options(ErectionOptions)
+def optimise_for_erection(
+    source: Any,
+    material: Hyperelastic | None = None,
+    thickness: float | None = None,
+    *,
+    solver: SolveOptions | None = None,
+    options: ErectionOptions | None = None,
+    tolerance: float = 0.01,
+    callback: Callable[[OptimumRecord], None] | None = None,
+    **settings: Any,
+) -> OptimisedPatterns:
+    """Change the patterns so that the structure they build carries the intended prestress
+    and keeps the design's shape (module docs).
+
+    Parameters
+    ----------
+    source
+        What :func:`vares.erect` takes: a solve, a structure's result, or a list of them or of
+        :class:`Pattern` (the starting patterns: usually VaReS').
+    material, thickness, solver
+        As for :func:`vares.erect`.
+    options
+        The erection's options (supports, cables, pressure, wrinkling) and the optimiser's:
+        ``shape_weight`` ``w`` (a relative gain in the RMS shape deviation against the same in
+        the RMS force deviation; 0: forces only), ``shape_bound`` (the largest shape deviation
+        allowed, relative to the starting patterns'; None: no bound; a node further from the
+        design adds its excess, heavily weighted) and ``optimise_iterations``.
+    tolerance
+        Stop when a step lowers ``J`` by less than this fraction of it.
+    callback
+        Called with every iteration's record.
+    settings
+        Any field of :class:`ErectionOptions` as a keyword (listed below).
+    """
+    started = time.perf_counter()
+    (options,) = split_settings(settings, [options or ErectionOptions()])
+    shape_weight, shape_bound = options.shape_weight, options.shape_bound
+    iterations = options.optimise_iterations
+    patterns = patterns_of(source)
+    if material is None or thickness is None or solver is None:
+        from .erection import _defaults
+
+        material, thickness, solver = _defaults(source, material, thickness, solver)
+    first = _erect(patterns, material, thickness, solver, options, None)
+    if not first.converged:
+        return OptimisedPatterns(
+            patterns,
+            first,
+            first,
+            [],
+            False,
+            f"the starting patterns: {first.reason}",
+            shape_weight,
+        )
+    layout = _Layout(patterns, first)
+    seams = _seam_edges(patterns, first, layout)
+    # the start's deviations, but never below a strain of 1e-8 × the stiffness in force and
+    # 1e-9 of the size in shape (a pattern at the round-off of its solve is left as it is)
+    size = float(np.ptp(first.mesh.points, axis=0).max())
+    floors = (FLOOR * material.stiffness_scale * thickness, 1e-3 * FLOOR * size)
+    scales = (max(_rms(first), floors[0]), max(first.deviation()["rms"], floors[1]))
+    negligible = ((floors[0] / scales[0]) ** 2, shape_weight * (floors[1] / scales[1]) ** 2)
+    bound = None if shape_bound is None else shape_bound * first.deviation()["max"]
+
+    def model_of(p, e):
+        return _Model(p, e, layout, seams, scales, shape_weight, bound, solver.linear_solver)
+
+    current, erected = patterns, first
+    model = model_of(current, erected)
+    objective = float(model.residual @ model.residual)
+    history = [_record(0, objective, model, erected, current, seams, 0.0, 0, True)]
+    if callback is not None:
+        callback(history[-1])
+    edges = _pattern_edges(patterns, layout)
+    mu, reason, converged = None, None, False
+    for iteration in range(1, iterations + 1):
+        if model.parts[0] <= negligible[0] and model.parts[1] <= negligible[1]:  # round-off
+            converged = True
+            break
+        op = model.operator()
+        if mu is None:
+            mu = INITIAL_DAMPING * _norm_squared(op)
+        step, lsqr_its = _lsqr(op, model, mu)
+        if len(seams):
+            step = model.projection()(step)  # seams kept matched to first order
+        strain = _edge_strain(current, step, edges, layout)
+        if strain > MAX_STEP_STRAIN:
+            step *= MAX_STEP_STRAIN / strain
+        predicted = objective - float(np.sum((model.residual + op.matvec(step)) ** 2))
+        if predicted < 0.1 * tolerance * objective:
+            converged = True  # the model promises no more
+            break
+        trial = _matched(_moved(current, layout.split(step)), seams, layout)
+        attempt = _trial_erection(trial, material, thickness, solver, options, erected)
+        accepted, decrease = False, 0.0
+        if attempt is not None:
+            trial_model = model_of(trial, attempt)
+            value = float(trial_model.residual @ trial_model.residual)
+            gain = (objective - value) / predicted if predicted > 0 else -1.0
+            if value < objective:
+                accepted, decrease = True, (objective - value) / objective
+                current, erected, model, objective = trial, attempt, trial_model, value
+                mu *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
+        if not accepted:
+            mu *= 4.0
+        record = _record(
+            iteration, objective, model, erected, current, seams, mu, lsqr_its, accepted
+        )
+        history.append(record)
+        if callback is not None:
+            callback(record)
+        if accepted and decrease < tolerance:
+            converged = True
+            break
+    else:
+        converged = True  # every step taken lowered the objective: the patterns are usable
+    if not converged:
+        reason = "no step lowers the objective"
+    return OptimisedPatterns(
+        current,
+        first,
+        erected,
+        history,
+        converged,
+        None if converged else reason,
+        shape_weight,
+        elapsed=time.perf_counter() - started,
+    )
+
+
+def _lsqr(op, model, mu):
+    """The Levenberg–Marquardt step ``min |J Δ + r|² + μ |Δ|²`` (to LSQR's loose tolerance: the
+    step is inexact) and LSQR's iterations."""
+    tol = LSQR_TOLERANCE
+    out = spla.lsqr(op, -model.residual, damp=np.sqrt(mu), atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
+    return out[0], out[2]
+
+
+def _norm_squared(op, iterations: int = 4) -> float:
+    """An estimate of ``|J|²`` (power iteration on ``JᵀJ``)."""
+    v = np.random.default_rng(0).normal(size=op.shape[1])
+    value = 0.0
+    for _ in range(iterations):
+        v /= np.linalg.norm(v)
+        w = op.rmatvec(op.matvec(v))
+        value = float(np.linalg.norm(w))
+        v = w
+    return value
+
+
+def _trial_erection(trial, material, thickness, solver, options, erected):
+    """The erection of trial patterns from the last erected state, or None where a pattern
+    cell turned over or the erection did not converge."""
+    try:
+        attempt = _erect(trial, material, thickness, solver, options, erected.erected_points)
+    except ValueError:  # a pattern cell turned over
+        return None
+    return attempt if attempt.converged else None
+
+
+def _pattern_edges(patterns: list[Pattern], layout: _Layout) -> np.ndarray:
+    """Every edge of every pattern cell ``(k, 2)`` (variable node ids)."""
+    out = []
+    for p, pattern in enumerate(patterns):
+        for cells in pattern.mesh.cells.values():
+            rolled = np.roll(cells, -1, axis=1)
+            out.append(layout.offsets[p] + np.column_stack([cells.ravel(), rolled.ravel()]))
+    return np.unique(np.sort(np.vstack(out), axis=1), axis=0)
+
+
+def _edge_strain(patterns, step, edges, layout) -> float:
+    """The largest change of a pattern edge's length by ``step``, relative to its length."""
+    X = np.concatenate([p.material_coordinates for p in patterns])
+    d = step.reshape(-1, 2)
+    vectors = X[edges[:, 1]] - X[edges[:, 0]]
+    lengths = np.linalg.norm(vectors, axis=1)
+    change = np.einsum("ki,ki->k", vectors, d[edges[:, 1]] - d[edges[:, 0]]) / lengths
+    return float(np.max(np.abs(change) / lengths))
+
+
+def _moved(patterns: list[Pattern], steps: list[np.ndarray]) -> list[Pattern]:
+    return [
+        replace(p, material_coordinates=p.material_coordinates + s)
+        for p, s in zip(patterns, steps, strict=True)
+    ]
+
+
+def _record(iteration, objective, model, erected, patterns, seams, mu, lsqr_its, accepted):
+    deviation = erected.deviation()
+    mismatch = 0.0
+    if len(seams):
+        X = np.concatenate([p.material_coordinates for p in patterns])
+        ends = X[seams]
+        lengths = np.linalg.norm(ends[:, :, 1] - ends[:, :, 0], axis=-1)
+        mismatch = float(np.abs(lengths[:, 0] - lengths[:, 1]).max())
+    return OptimumRecord(
+        iteration,
+        objective,
+        model.parts[0],
+        model.parts[1],
+        _rms(erected),
+        deviation["max"],
+        deviation["rms"],
+        mismatch,
+        mu,
+        int(lsqr_its or 0),
+        accepted,
+    )
+
+
+def optimised_results(
+    results: list[PatternResult], optimum: OptimisedPatterns
+) -> list[PatternResult]:
+    """The solves' results with the optimised patterns in place of theirs (energy on the design
+    shape and per-cell fields of the new patterns; the rest, history included, as solved)."""
+    out = []
+    for result, pattern in zip(results, optimum.patterns, strict=True):
+        coordinates = np.asarray(pattern.material_coordinates, dtype=float)
+        problem = Problem(
+            result.mesh,
+            result.material,
+            result.thickness,
+            fibres=result.fibres,
+            prestress=result.prestress,
+        )
+        out.append(
+            replace(
+                result,
+                material_coordinates=coordinates,
+                energy=float(problem.energy(coordinates)),
+                _fields=None,
+            )
+        )
+    return out
