@@ -155,3 +155,41 @@ def test_every_erection_option_is_reachable_from_all_three_with_one_default():
         flag = "--" + name.replace("_", "-")
         for command in ("pattern", "example", "panels", "erect"):
             assert flag in run(command, "--help").stdout, (name, command)
+
+
+def test_optimise_writes_the_optimised_patterns_and_both_erections(tmp_path):
+    """`vares panels --erect --optimise`: the written patterns are the optimised ones (they
+    erect as erect.json says), erect.json keeps the VaReS patterns' erected figures under
+    `optimisation`, and the optimised patterns carry the intended mean forces closer; the
+    seams stay matched in structure.json; without --erect, --optimise is refused."""
+    flags = ["--fabric", "pes-pvc-type-2", "--prestress", "2,1.5", "--warp-direction", "0,1,0"]
+    out = tmp_path / "strips"
+    result = run(
+        "panels", "--example", "hypar-strips", "-o", out, *flags, "--erect", "--optimise", "-q"
+    )
+    assert result.exit_code == 0, result.stderr
+    erected = json.loads((out / "erect" / "erect.json").read_text())
+    optimisation = erected["optimisation"]
+    assert optimisation["converged"] and optimisation["iterations"] >= 1
+    start = optimisation["start_erected"]["stress"]
+    for yarn, intended in (("warp", 2.0), ("fill", 1.5)):
+        assert (
+            abs(erected["stress"][yarn]["mean"] - intended) < abs(start[yarn]["mean"] - intended)
+            or abs(erected["stress"][yarn]["mean"] - intended) < 1e-3 * intended
+        )
+    rms = [
+        np.hypot(s["warp"]["rms_deviation"], s["fill"]["rms_deviation"])
+        for s in (start, erected["stress"])
+    ]
+    assert rms[1] < rms[0]
+    structure = json.loads((out / "structure.json").read_text())
+    assert max(s["max_segment_mismatch_after"] for s in structure["seams"]) < 1e-9
+    # the written patterns are the optimised ones: erected again, they give erect.json's forces
+    again = run("erect", out, "-f", "-q")
+    assert again.exit_code == 0, again.stderr
+    plain = json.loads((out / "erect" / "erect.json").read_text())
+    assert plain["stress"]["warp"]["mean"] == pytest.approx(
+        erected["stress"]["warp"]["mean"], rel=1e-6
+    )
+    refused = run("panels", "--example", "hypar-strips", "-o", tmp_path / "x", *flags, "--optimise")
+    assert refused.exit_code == 2 and "--erect" in error_line(refused)

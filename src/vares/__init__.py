@@ -23,11 +23,13 @@ if TYPE_CHECKING:
     from .analysis import (
         ErectionOptions,
         ErectionResult,
+        OptimisedPatterns,
         PatternEvaluation,
         cell_fields,
         compensation_report,
         erect,
         evaluate,
+        optimise_for_erection,
     )
     from .geometry import MeshError, ProjectionPlane, SurfaceMesh, examples, projection_plane
     from .io import read_mesh, read_mesh_data

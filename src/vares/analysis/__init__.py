@@ -1,5 +1,6 @@
 """What a pattern does: per-cell results of any pattern, the compensation report, statistics,
-the erection analysis (the structure built from its patterns), and the producibility of a
+the erection analysis (the structure built from its patterns) and patterns optimised for it,
+and the producibility of a
 draped ply."""
 
 from typing import TYPE_CHECKING
@@ -14,6 +15,7 @@ if TYPE_CHECKING:
     from .drape_options import DrapeOptions
     from .erection import ErectionResult, erect
     from .erection_model import Pattern
+    from .erection_optimum import OptimisedPatterns, optimise_for_erection, optimised_results
     from .evaluate import PatternEvaluation, evaluate
     from .options import ErectionOptions
     from .producibility import Producibility, producibility

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -69,7 +69,7 @@ MATCH_STEPS = 5
 FLOOR = 1e-8
 #: The weight of each yarn's mean force deviation against the per-cell deviations (the mean
 #: is held to the intended: a uniformly higher tension would lower the shape deviation).
-MEAN_WEIGHT = 100.0
+MEAN_WEIGHT = 30.0
 #: The weight of a node's shape deviation beyond the bound, against the RMS terms.
 BOUND_WEIGHT = 100.0
 
@@ -105,12 +105,40 @@ class OptimisedPatterns:
     converged: bool
     reason: str | None
     shape_weight: float
+    shape_bound: float | None = None
     elapsed: float = 0.0
-    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def iterations(self) -> int:
         return sum(1 for r in self.history if r.iteration > 0)
+
+    def to_dict(self) -> dict[str, object]:
+        """What ``erect.json`` holds under ``optimisation``: the optimiser's settings and
+        iterations, and the erected figures of the starting (VaReS) patterns beside which the
+        file's own figures are those of the optimised ones."""
+        return {
+            "converged": self.converged,
+            "reason": self.reason,
+            "iterations": self.iterations,
+            "shape_weight": self.shape_weight,
+            "shape_bound": self.shape_bound,
+            "elapsed_seconds": self.elapsed,
+            "start_erected": {
+                "deviation": self.start.deviation(),
+                **self.start.statistics(),
+            },
+            "history": [
+                {
+                    "iteration": r.iteration,
+                    "objective": r.objective,
+                    "force_rms": r.force_rms,
+                    "deviation_max": r.deviation_max,
+                    "seam_mismatch": r.seam_mismatch,
+                    "accepted": r.accepted,
+                }
+                for r in self.history
+            ],
+        }
 
 
 class _Layout:
@@ -405,6 +433,7 @@ def optimise_for_erection(
             False,
             f"the starting patterns: {first.reason}",
             shape_weight,
+            shape_bound,
         )
     layout = _Layout(patterns, first)
     seams = _seam_edges(patterns, first, layout)
@@ -478,6 +507,7 @@ def optimise_for_erection(
         converged,
         None if converged else reason,
         shape_weight,
+        shape_bound,
         elapsed=time.perf_counter() - started,
     )
 

@@ -12,12 +12,16 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path, write_json
 from ..io.meshes import write_surface
+
+if TYPE_CHECKING:
+    from ..analysis.erection_optimum import OptimisedPatterns
 
 __all__ = ["ERECTION_FILES", "erected_pictures", "erection_files", "write_erection"]
 
@@ -53,8 +57,19 @@ def erected_pictures(result: ErectionResult, units: str) -> dict[str, tuple[str,
     }
 
 
-def write_erection(result: ErectionResult, directory: Path, units: str) -> list[Path]:
-    """The files of an erection (:data:`ERECTION_FILES`) in ``directory``; returns their paths."""
+def _erect_json(result: ErectionResult, units: str, optimum) -> dict[str, object]:
+    out = result.to_dict(units=units)
+    if optimum is not None:
+        out["optimisation"] = optimum.to_dict()
+    return out
+
+
+def write_erection(
+    result: ErectionResult, directory: Path, units: str, optimum: OptimisedPatterns | None = None
+) -> list[Path]:
+    """The files of an erection (:data:`ERECTION_FILES`) in ``directory``; returns their paths.
+    With ``optimum`` (the erection is that of optimised patterns), ``erect.json`` holds the
+    optimisation and the starting patterns' erected figures under ``optimisation``."""
     from ..io.plot import DPI, plot_surface_fields
 
     files = []
@@ -65,7 +80,7 @@ def write_erection(result: ErectionResult, directory: Path, units: str) -> list[
         "held": result.held.astype(float),
     }
     writers = {
-        "erect.json": lambda p: write_json(p, result.to_dict(units=units)),
+        "erect.json": lambda p: write_json(p, _erect_json(result, units, optimum)),
         "erected.vtu": lambda p: write_surface(
             p, result.mesh, result.erected_points, fields, points, units=units
         ),

@@ -17,8 +17,9 @@ from ..units import unit_factor
 from .job import Job
 from .sections import STRUCTURE_MARK_SPACING
 
-if TYPE_CHECKING:  # a drape is made (and its module imported) only when a job asks for one
+if TYPE_CHECKING:  # made (and their modules imported) only when a job asks for them
     from ..analysis.drape import PlyDrape
+    from ..analysis.erection_optimum import OptimisedPatterns
 
 __all__ = ["JobOutcome", "PanelOutcome"]
 
@@ -44,8 +45,9 @@ class PanelOutcome:
 class JobOutcome:
     """What a job produced: one :class:`PanelOutcome` per pattern (one for a single surface),
     the structure's result for a structure (and the cut's for a cut job), the erection (when
-    asked for), the output folder, the length units, what the input's repair changed, and every
-    file written."""
+    asked for; of the optimised patterns with ``[erection] optimise``, ``optimum`` holding the
+    optimisation and the VaReS patterns' erection), the output folder, the length units, what
+    the input's repair changed, and every file written."""
 
     job: Job
     material: Hyperelastic
@@ -56,6 +58,7 @@ class JobOutcome:
     repairs: dict[str, dict[str, object]] = field(default_factory=dict)
     cut: CutResult | None = None
     erection: ErectionResult | None = None
+    optimum: OptimisedPatterns | None = None
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 

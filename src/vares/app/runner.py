@@ -15,6 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from ..analysis.checks import pattern_warnings
 from ..analysis.compensation import compensation_report
 from ..analysis.erection import ErectionResult, erect
@@ -150,7 +152,9 @@ def _write(outcome: JobOutcome, root: Path, save_job: Path | None, folder: Outpu
         write_cut(outcome)
     outcome.files.append(write_job_file(job, root))
     if outcome.erection is not None:
-        outcome.files += write_erection(outcome.erection, root / "erect", outcome.units)
+        outcome.files += write_erection(
+            outcome.erection, root / "erect", outcome.units, outcome.optimum
+        )
     if job.output.report:
         from .report import write_reports
 
@@ -181,12 +185,16 @@ def _moved(outcome: JobOutcome, directory: Path, root: Path) -> None:
 
 def _erect(outcome: JobOutcome, options, callback) -> None:
     """Erect the structure from the job's patterns (patterns that did not converge are not
-    erected: a warning says so)."""
+    erected: a warning says so); with ``[erection] optimise``, optimise the patterns for the
+    erected structure first and erect those (the job's patterns are then the optimised ones)."""
     job = outcome.job
     if not outcome.patterned:
         outcome.warnings.append("not erected: the patterns did not converge")
         return
     patterns = [Pattern.of(p.result, p.name) for p in outcome.panels]
+    if job.erection.optimise:
+        _optimise(outcome, patterns, options)
+        return
     outcome.erection = erect(
         patterns,
         outcome.material,
@@ -195,6 +203,56 @@ def _erect(outcome: JobOutcome, options, callback) -> None:
         options=job.erection,
         callback=callback,
     )
+
+
+def _optimise(outcome: JobOutcome, patterns: list[Pattern], options) -> None:
+    """Patterns optimised for the erected structure in place of the job's (the erection of the
+    VaReS patterns kept beside it)."""
+    from ..analysis.erection_optimum import optimise_for_erection, optimised_results
+
+    job = outcome.job
+    optimum = optimise_for_erection(
+        patterns, outcome.material, job.material.thickness, solver=options, options=job.erection
+    )
+    outcome.optimum, outcome.erection = optimum, optimum.erected
+    if not optimum.converged:
+        outcome.warnings.append(f"the patterns were not optimised: {optimum.reason}")
+        return
+    results = optimised_results([p.result for p in outcome.panels], optimum)
+    source = Input(panels=[], units=outcome.units)
+    for k, (panel, result) in enumerate(zip(outcome.panels, results, strict=True)):
+        fresh = _panel(job, source, panel.name, panel.mesh, result)
+        panel.result, panel.compensation, panel.warnings = (
+            result,
+            fresh.compensation,
+            fresh.warnings,
+        )
+        if outcome.structure is not None:
+            outcome.structure.results[k] = result
+    if outcome.structure is not None:
+        outcome.structure.seam_reports = _seam_reports_after(outcome.structure)
+
+
+def _seam_reports_after(structure):
+    """The structure's seam reports with the lengths of its (optimised) patterns as those after
+    matching."""
+    from dataclasses import replace
+
+    from ..structures.seams import seam_lengths
+
+    coordinates = [r.material_coordinates for r in structure.results]
+    out = []
+    for report, seam in zip(structure.seam_reports, structure.seams, strict=True):
+        first, second = seam_lengths(coordinates, seam)
+        out.append(
+            replace(
+                report,
+                length_first_after=float(first.sum()),
+                length_second_after=float(second.sum()),
+                max_segment_mismatch_after=float(np.max(np.abs(first - second) / first)),
+            )
+        )
+    return out
 
 
 @dataclass
