@@ -104,6 +104,41 @@ def test_missing_file_and_bad_options(tmp_path):
     assert result.exit_code == 2 and "--plane" in error_line(result)
 
 
+def test_an_internal_error_is_no_usage_error(tmp_path, monkeypatch):
+    """Exit 2 is for what vares refuses; a ValueError that numpy raises (arrays vares got wrong)
+    is an internal error, exit 3, although it is a ValueError too."""
+    import typer
+
+    from vares.app.cli.common import guarded
+    from vares.geometry.mesh import MeshError
+    from vares.units import unit_factor
+
+    def code(body) -> int:
+        with pytest.raises(typer.Exit) as raised:
+            guarded(body)
+        return raised.value.exit_code
+
+    def mesh_error():
+        raise MeshError("bad cells")
+
+    assert code(lambda: np.ones(37) * np.ones(39)) == 3
+    assert code(lambda: np.linalg.inv(np.ones((2, 3)))) == 3
+    assert code(lambda: unit_factor("parsec", "m")) == 2  # vares's own ValueError
+    assert code(mesh_error) == 2
+    assert code(lambda: b"\xff".decode("utf-8")) == 2  # a file that is no text
+
+    def broadcasting(*args, **kwargs):
+        return np.ones(37) * np.ones(39)
+
+    monkeypatch.setattr("vares.structures.cutting.plan_strips", broadcasting)
+    path = tmp_path / "hypar.obj"
+    mesh = hypar(n=4)
+    meshio.write(path, meshio.Mesh(mesh.points, [("triangle", mesh.cells["triangle"])]))
+    result = run("cut", path, "--roll-width", 2.5, "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 3, result.stderr
+    assert error_line(result).startswith("vares: error: internal error: ValueError: operands")
+
+
 def test_failed_solve_exits_1_with_the_reason_and_writes_no_pattern(tmp_path):
     out = tmp_path / "out"
     result = run("example", "cylinder160", "-o", out, "--strategy", "newton", "-q")

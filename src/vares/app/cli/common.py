@@ -3,6 +3,7 @@ showing what it did."""
 
 from __future__ import annotations
 
+import dis
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,7 +22,7 @@ if TYPE_CHECKING:  # the engine is imported when a command runs, not to build th
     from ..job import Job
     from ..outcome import JobOutcome, PanelOutcome
 
-__all__ = ["console", "execute", "fail", "field_table", "guarded", "show_erection"]
+__all__ = ["console", "execute", "fail", "field_table", "guarded", "refused", "show_erection"]
 
 console = Console(stderr=True, highlight=False, soft_wrap=True)
 
@@ -34,27 +35,22 @@ def fail(message: str, code: int) -> int:
 
 def guarded(body: Callable[[], None]) -> None:
     """Run a command body, turning known errors into one-line messages and exit codes (2: bad
-    input or options, 1: the solve did not converge, 3: unexpected internal error)."""
-    from ...geometry.mesh import MeshError
+    input or options, 1: the solve did not converge, 3: unexpected internal error).
+
+    A ``ValueError`` is bad input when vares says so (:func:`refused`); one that escaped from
+    numpy, scipy or another library is an internal error, whatever its type."""
     from ...io.files import OutputExistsError
-    from ...materials import MaterialError
-    from ...options import OptionsError
     from ..job import JobError
 
     try:
         body()
     except typer.Exit:
         raise
-    except (
-        MeshError,
-        MaterialError,
-        InputError,
-        JobError,
-        OptionsError,
-        OutputExistsError,
-        FileNotFoundError,
-        ValueError,
-    ) as exc:
+    except (InputError, JobError, OutputExistsError, FileNotFoundError) as exc:
+        raise typer.Exit(fail(str(exc), 2)) from None
+    except ValueError as exc:
+        if not refused(exc):
+            raise typer.Exit(fail(f"internal error: {type(exc).__name__}: {exc}", 3)) from None
         raise typer.Exit(fail(str(exc), 2)) from None
     except OSError as exc:
         raise typer.Exit(fail(f"{exc.strerror or exc}: {exc.filename or ''}".strip(), 2)) from None
@@ -62,6 +58,25 @@ def guarded(body: Callable[[], None]) -> None:
         raise typer.Exit(fail("interrupted", 130)) from None
     except Exception as exc:  # one line, never a traceback
         raise typer.Exit(fail(f"internal error: {type(exc).__name__}: {exc}", 3)) from None
+
+
+def refused(exc: ValueError) -> bool:
+    """Whether a ``ValueError`` is vares refusing an input: an error type of vares
+    (``MeshError``, ``OptionsError``, ``CuttingError``, …), text that is no text
+    (``UnicodeError``), or a ``ValueError`` raised by a ``raise`` statement in vares's own code.
+    Not one raised inside a library, such as numpy's "operands could not be broadcast": that is
+    vares handing it arrays it should not have (a bug), though it reaches vares's frame from C."""
+    if type(exc).__module__.partition(".")[0] == "vares" or isinstance(exc, UnicodeError):
+        return True
+    if type(exc) is not ValueError or exc.__traceback__ is None:
+        return False
+    last = exc.__traceback__
+    while last.tb_next is not None:
+        last = last.tb_next
+    frame = last.tb_frame
+    if frame.f_globals.get("__name__", "").partition(".")[0] != "vares":
+        return False
+    return frame.f_code.co_code[last.tb_lasti] == dis.opmap["RAISE_VARARGS"]
 
 
 def progress(quiet: bool) -> Callable[[IterationRecord], None] | None:
@@ -179,6 +194,8 @@ def _show_cut(outcome: JobOutcome) -> None:
         f"{plan.cut.worst_angle:.1f}° (surface {result.surface_worst_angle:.1f}°); area 3D "
         f"{result.panel_area:.6g} of {result.surface_area:.6g} {units}²"
     )
+    for note in result.notes:
+        console.print(f"  {note}")
     if result.nest is not None:
         nest = result.nest
         console.print(
