@@ -2,6 +2,7 @@
 
 import itertools
 import json
+from pathlib import Path
 
 import ezdxf
 import meshio
@@ -12,6 +13,7 @@ from shapely.geometry import Point, Polygon
 
 import vares
 from vares.geometry.examples import saddle, tent_roof
+from vares.geometry.surface_lines import triangulated
 
 FABRIC = vares.materials.fabric("pes-pvc-type-2").material()
 
@@ -163,3 +165,24 @@ def test_cutting_along_the_users_lines_from_the_api_the_command_and_a_job(tmp_pa
     result = run("run", job)
     assert result.exit_code == 2 and "needs a curves file" in error_line(result)
     assert not (tmp_path / "job-out").exists()
+
+
+def test_a_coarse_design_with_sagging_edges_is_cut_patterned_and_nested(tmp_path):
+    """compas-FoFin's wave (tests/data): its cable edges sag between the supports, so the
+    geodesics between the ends of plane sections near them run towards each other (they met:
+    exit 2 before). The strips fit, cover the surface, their seams match, they are nested."""
+    source = Path(__file__).parent / "data" / "fofin_wave.obj"
+    out = tmp_path / "wave"
+    result = run(
+        "cut", source, "--units", "m", "--roll-width", 1.5, "-o", out,
+        "--fabric", "pes-pvc-type-2", "--prestress", "2,1.5", "--nest-time", 1, "-q",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "cut.json").read_text())
+    mesh = triangulated(vares.read_mesh(source))  # its quads split, as the cut splits them
+    assert max(p["width"] for p in data["panels"]) <= 1.5
+    assert sum(p["area"] for p in data["panels"]) == pytest.approx(mesh.area, rel=1e-12)
+    for seam in data["seams"]:
+        a, b = seam["length_2d"]
+        assert abs(a - b) <= 1e-9 * a
+    assert 0 < data["nesting"]["yield"] < 1

@@ -19,12 +19,13 @@ import numpy as np
 from ..geometry.cutting import CutMesh
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.outline import allowance_outline
-from ..geometry.surface_lines import min_angles, triangulated
+from ..geometry.refine import refine
+from ..geometry.surface_lines import CuttingError, min_angles, triangulated
 from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
 from ..solver import IterationRecord, SolveOptions
 from ..units import unit_factor
-from .layout import StripPlan, plan_strips, strips_along_lines
+from .layout import CELLS_ACROSS, StripPlan, plan_strips, strips_along_lines
 from .matching import StructureResult, solve_structure
 from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
@@ -105,6 +106,26 @@ class CutResult:
         """Total 3D area of the panels."""
         return float(sum(p.mesh.area for p in self.plan.panels))
 
+    @property
+    def notes(self) -> list[str]:
+        """What the cut did to the surface and to the lines, for the user to know: the surface
+        refined on its own faces, geodesics replaced by plane sections."""
+        plan, notes = self.plan, []
+        if plan.refinements:
+            rounds = "round" if plan.refinements == 1 else "rounds"
+            notes.append(
+                f"the surface was refined on its own faces ({plan.refinements} {rounds} of "
+                f"midpoint subdivision, {plan.input_cells:,} → {plan.refined_cells:,} triangles) "
+                f"so that every strip is at least {CELLS_ACROSS} cells across; its shape and "
+                "area are unchanged"
+            )
+        if plan.replaced_geodesics:
+            notes.append(
+                f"{plan.replaced_geodesics} of {len(plan.lines)} cutting lines are plane sections "
+                "in place of geodesics that ran towards a neighbour or along the boundary"
+            )
+        return notes
+
 
 @takes_options(SolveOptions, StructureOptions, CutOptions)
 def cut(
@@ -137,7 +158,7 @@ def cut(
         settings, [options or SolveOptions(), structure or StructureOptions()]
     )
     if (cutting.seams == "curves") != (lines is not None):
-        raise ValueError("seams = 'curves' and the cutting lines (lines=[…]) go together")
+        raise CuttingError("seams = 'curves' and the cutting lines (lines=[…]) go together")
     started = time.perf_counter()
     scale = unit_factor(dxf_units, units)
     usable = usable_width(cutting.roll_width)
@@ -206,8 +227,12 @@ def _plan(surface, target, cutting: CutOptions, allowances, options, lines) -> S
     if cutting.seams == "curves":
         from ..geometry.drawn_lines import curves_on_surface
 
-        base, on_surface = curves_on_surface(surface, lines, cutting.snap)
-        return strips_along_lines(base, on_surface, cutting.snap, options.warp_direction)
+        fine, rounds = refine(surface, target / CELLS_ACROSS)
+        base, on_surface = curves_on_surface(fine, lines, cutting.snap)
+        plan = strips_along_lines(base, on_surface, cutting.snap, options.warp_direction)
+        plan.refinements, plan.input_cells = rounds, len(surface.cells["triangle"])
+        plan.refined_cells = len(fine.cells["triangle"])
+        return plan
     edge_kind = cutting.edge_type
     return plan_strips(
         surface,

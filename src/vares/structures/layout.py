@@ -59,7 +59,7 @@ CELLS_ACROSS = 2
 STRAY = 0.4
 #: Pieces of a plane section shorter than this fraction of the roll width are no cutting lines.
 _SHORTEST = 0.1
-#: Further rounds of refinement at most when planned lines meet.
+#: Further refinements at most, when planned lines meet, before plane sections replace geodesics.
 _RETRIES = 2
 
 
@@ -73,7 +73,7 @@ class StripPlan:
     strips' extents across their warps, allowances included (mesh units); ``evaluations`` counts
     the layouts tried, ``history`` the widest strip for every number of gaps between lines tried.
     ``refinements`` is the number of rounds the surface was refined on its own faces before it
-    was cut (``input_cells`` its triangles before, the cut mesh has the rest), and
+    was cut (``input_cells`` its triangles before, ``refined_cells`` after), and
     ``replaced_geodesics`` the number of geodesics replaced by their plane sections (module docs).
     """
 
@@ -87,6 +87,7 @@ class StripPlan:
     history: list[tuple[int, float]] = field(default_factory=list)  # (gaps, widest)
     refinements: int = 0
     input_cells: int = 0
+    refined_cells: int = 0
     replaced_geodesics: int = 0
 
 
@@ -168,29 +169,39 @@ def plan_strips(
 
 class _Refined:
     """The surface the lines are placed on: refined on its own faces until its edges are at most
-    ``width / CELLS_ACROSS`` long, and further (up to ``_RETRIES`` rounds, each halving that
-    length) when planned lines meet; then plane sections in place of geodesics."""
+    ``width / CELLS_ACROSS`` long, and further (each time halving that length; ``_RETRIES``
+    times at most for the whole plan) when planned lines meet; then plane sections in place of
+    geodesics where they still do."""
 
     def __init__(self, surface: SurfaceMesh, width: float) -> None:
         self.width, self.longest = width, width / CELLS_ACROSS
         self.surface, self.rounds = refine(surface, self.longest)
+        self.retries = _RETRIES
 
     def layout(self, family, spans, seams, snap, warp_direction) -> StripPlan:
-        for retry in range(_RETRIES + 1):
+        while True:
             try:
                 plan = _layout(self.surface, family, spans, seams, snap, warp_direction, self.width)
-                plan.refinements = self.rounds
-                return plan
+                return self._counted(plan)
             except LinesMeetError:
-                if retry == _RETRIES and seams == "planar":
-                    raise
-                if retry == _RETRIES:
+                if not self.retries:
                     break
+            self.retries -= 1
             self.longest /= 2
             self.surface, rounds = refine(self.surface, self.longest)
             self.rounds += rounds
-        plan = _layout(self.surface, family, spans, "planar", snap, warp_direction, self.width)
-        plan.refinements, plan.replaced_geodesics = self.rounds, len(plan.lines)
+        try:  # plane sections of different parameters never cross: only a snap joins them
+            plan = _layout(self.surface, family, spans, "planar", snap, warp_direction, self.width)
+        except LinesMeetError as exc:
+            raise CuttingError(
+                f"the cutting lines for strips of {self.width:g} meet even on the surface refined "
+                f"{self.rounds} times ({exc}): try a wider roll, another layout or strip direction"
+            ) from None
+        plan.replaced_geodesics = len(plan.lines) if seams == "geodesic" else 0
+        return self._counted(plan)
+
+    def _counted(self, plan: StripPlan) -> StripPlan:
+        plan.refinements, plan.refined_cells = self.rounds, len(self.surface.cells["triangle"])
         return plan
 
 
