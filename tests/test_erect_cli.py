@@ -193,3 +193,42 @@ def test_optimise_writes_the_optimised_patterns_and_both_erections(tmp_path):
     )
     refused = run("panels", "--example", "hypar-strips", "-o", tmp_path / "x", *flags, "--optimise")
     assert refused.exit_code == 2 and "--erect" in error_line(refused)
+
+
+def test_panels_take_their_intended_prestress_per_cell_from_the_input(tmp_path):
+    """A structure in one VTU with a panel field and per-cell membrane forces (as form finding
+    writes them): each panel is patterned for its own cells' rows, the erection is judged
+    against them (erected.vtu: force minus the field), and `vares erect DIR` reads them again."""
+    mesh, ids = vares.examples.hypar_strips(strips=4, cells_per_strip=3, n=12)
+    centre = mesh.points[mesh.cells["triangle"]].mean(axis=1)
+    warp, fill = 2.0 + 0.1 * centre[:, 0], 1.5 + 0.05 * centre[:, 1]
+    source = tmp_path / "strips.vtu"
+    meshio.write(
+        source,
+        meshio.Mesh(
+            mesh.points,
+            [("triangle", mesh.cells["triangle"])],
+            cell_data={"panel": [ids], "n_warp": [warp], "n_fill": [fill]},
+        ),
+    )
+    flags = ["--fabric", "pes-pvc-type-2", "--prestress-field", "n_warp,n_fill"]
+    out = tmp_path / "out"
+    result = run("panels", source, "-o", out, *flags, "--warp-direction", "0,1,0", "--erect", "-q")
+    assert result.exit_code == 0, result.stderr
+    erected = meshio.read(out / "erect" / "erected.vtu")
+    data = {k: v[0] for k, v in erected.cell_data.items()}
+    # the welded cells are the panels' cells in turn: find each cell's field row by its centre
+    welded = erected.points[erected.cells_dict["triangle"]].mean(axis=1)
+    design = mesh.points[mesh.cells["triangle"]].mean(axis=1)
+    order = [int(np.argmin(np.linalg.norm(design - c, axis=1))) for c in welded]
+    np.testing.assert_allclose(
+        data["warp_stress"] - data["warp_stress_difference"], warp[order], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        data["fill_stress"] - data["fill_stress_difference"], fill[order], atol=1e-12
+    )
+    first = json.loads((out / "erect" / "erect.json").read_text())
+    again = run("erect", out, "-f", "-q")
+    assert again.exit_code == 0, again.stderr
+    second = json.loads((out / "erect" / "erect.json").read_text())
+    assert second["stress"] == first["stress"]

@@ -31,7 +31,8 @@ DEFAULT_UNITS = "m"
 class Input:
     """The surfaces of a job (one for a single pattern), the cell data of a single mesh file
     (global cell order), the length units, what the repair changed (per file), warnings about
-    the input, and the pattern to start from (if the job names one)."""
+    the input, the pattern to start from (if the job names one) and, for a structure, the cell
+    data of every panel."""
 
     panels: list[Panel]
     units: str
@@ -39,6 +40,8 @@ class Input:
     repairs: dict[str, dict[str, object]] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     initial_pattern: np.ndarray | None = None
+    #: per panel of a structure, its cells' data (each panel's own cell order)
+    panel_cell_data: list[dict[str, np.ndarray]] = field(default_factory=list)
 
 
 def load_input(job: Job) -> Input:
@@ -134,11 +137,15 @@ def _structure(job: Job) -> Input:
         files = [_read(job, p) for p in paths]
         panels = [Panel(f.path.stem, f.surface()) for f in files]
         loaded = Input(panels, _units(job, [f.units for f in files]))
+        loaded.panel_cell_data = [f.cell_data for f in files]
         _note(loaded, files)
     else:
         mesh_file = _read(job, paths[0])
-        panels = _split(job, mesh_file)
+        panels, cell_ids = _split(job, mesh_file)
         loaded = Input(panels, _units(job, [mesh_file.units]))
+        loaded.panel_cell_data = [
+            {k: np.asarray(v)[ids] for k, v in mesh_file.cell_data.items()} for ids in cell_ids
+        ]
         _note(loaded, [mesh_file])
     if len(loaded.panels) < 2:
         raise JobError("a structure needs at least two panels")
@@ -152,19 +159,24 @@ def _structure(job: Job) -> Input:
     return loaded
 
 
-def _split(job: Job, mesh_file: MeshFile) -> list[Panel]:
-    """Panels by the panel field of the cell data or, without one, the mesh's separate pieces."""
+def _split(job: Job, mesh_file: MeshFile) -> tuple[list[Panel], list[np.ndarray]]:
+    """Panels by the panel field of the cell data or, without one, the mesh's separate pieces;
+    and the global ids of each panel's cells (in its own cell order)."""
     key = job.input.panel_field
     if key in mesh_file.cell_data:
         names = mesh_file.cell_names.get(key)  # a DXF's layer names
-        return split_panels(mesh_file.surface(), mesh_file.cell_data[key], names)
+        ids = np.asarray(mesh_file.cell_data[key]).ravel()
+        panels = split_panels(mesh_file.surface(), ids, names)
+        # split_panels takes each panel's cells in the global order (type blocks in turn)
+        return panels, [np.flatnonzero(ids == value) for value in np.unique(ids)]
     pieces = mesh_file.pieces()
     if len(pieces) < 2:
         raise MeshError(
             f"{mesh_file.path} is one piece and has no cell data {key!r} with panel ids "
             f"(it has: {', '.join(mesh_file.cell_data) or 'none'})"
         )
-    return [Panel(f"{mesh_file.path.stem}-{k + 1}", mesh) for k, (mesh, _) in enumerate(pieces)]
+    panels = [Panel(f"{mesh_file.path.stem}-{k + 1}", mesh) for k, (mesh, _) in enumerate(pieces)]
+    return panels, [cells for _, cells in pieces]
 
 
 def _read_json(path: Path) -> dict:
@@ -186,11 +198,15 @@ def saved_patterns(job: Job) -> list[Pattern]:
     else:
         names = [p["name"] for p in _read_json(directory / "structure.json")["panels"]]
         folders = [directory / safe_name(name) for name in names]
-    cell_data = {}
-    if job.prestress.field is not None:
-        _, cell_data = read_mesh_data(job.path(job.input.mesh))
+    cell_data = [{}] * len(folders)
+    if job.prestress.field is not None and job.structure is None:
+        cell_data = [read_mesh_data(job.path(job.input.mesh))[1]]
+    elif job.prestress.field is not None:  # each panel's rows of the field, as when solved
+        cell_data = load_input(job).panel_cell_data
+        if len(cell_data) != len(folders):
+            raise JobError("per-cell prestress needs the panels' cell data (a mesh file's)")
     patterns = []
-    for folder in folders:
+    for folder, data in zip(folders, cell_data, strict=True):
         summary = _read_json(folder / "summary.json")
         name = summary.get("name") or folder.name
         if not summary.get("converged"):
@@ -198,7 +214,7 @@ def saved_patterns(job: Job) -> list[Pattern]:
         mesh = read_mesh(folder / "surface.vtu")
         coordinates = read_pattern(folder / "pattern.vtu", mesh)
         fibres = Fibres(*(np.asarray(summary["fibres"][k], dtype=float) for k in ("warp", "fill")))
-        prestress = job.prestress.value(cell_data)
+        prestress = job.prestress.value(data)
         patterns.append(Pattern(mesh, coordinates, fibres, prestress, name))
     return patterns
 

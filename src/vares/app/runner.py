@@ -359,13 +359,17 @@ def _solve_one(job, source: Input, material, options, callback) -> JobOutcome:
 
 
 def _solve_structure(job, source: Input, material, options, callback) -> JobOutcome:
-    if job.prestress.field is not None:
-        raise JobError("per-cell prestress is not available for structures yet")
+    per_panel = None
+    if job.prestress.field is not None:  # each panel's cells' own rows of the field
+        per_panel = [job.prestress.value(data) for data in source.panel_cell_data]
+        if len(per_panel) != len(source.panels):  # a Rhino model's objects carry no cell data
+            raise JobError("per-cell prestress needs the panels' cell data (a mesh file's)")
     structure = solve_structure(
         source.panels,
         material,
         job.material.thickness,
-        prestress=job.prestress.value({}),
+        prestress=None if per_panel is not None else job.prestress.value({}),
+        panel_prestress=per_panel,
         options=options,
         structure=job.structure,
         callback=callback,

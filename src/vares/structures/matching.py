@@ -109,6 +109,7 @@ def solve_structure(
     *,
     seams: list[Seam] | None = None,
     prestress: float | Sequence[float] | None = None,
+    panel_prestress: Sequence[Any] | None = None,
     panel_settings: Sequence[Mapping[str, Any]] | None = None,
     options: SolveOptions | None = None,
     structure: StructureOptions | None = None,
@@ -121,7 +122,9 @@ def solve_structure(
     Every panel is solved by :func:`vares.solve` with the same options (fibres, strategy,
     tolerance, iteration limit …); the seam matching uses the same tolerance and iteration limit,
     and holds each panel's rigid modes as its solve did. ``seams`` default to
-    :func:`find_seams`; ``prestress`` is uniform (a number or warp, fill[, shear]).
+    :func:`find_seams`; ``prestress`` is uniform (a number or warp, fill[, shear]);
+    ``panel_prestress`` gives one prestress per panel instead (each what :func:`vares.solve`
+    takes, e.g. one row per cell of the panel: a form-found design's membrane forces).
     ``panel_settings`` change solve options per panel (one mapping per panel, e.g.
     ``{"warp_direction": (0, 1, 0)}`` to give every strip its own warp); each panel's result
     keeps the options it was solved with.
@@ -141,9 +144,15 @@ def solve_structure(
         if panel_settings
         else [options] * len(panels)
     )
+    if panel_prestress is not None and len(panel_prestress) != len(panels):
+        raise ValueError(
+            f"panel_prestress needs one prestress per panel ({len(panels)}); "
+            f"got {len(panel_prestress)}"
+        )
+    stresses = [prestress] * len(panels) if panel_prestress is None else list(panel_prestress)
     results = [
-        solve(p.mesh, material, thickness, prestress=prestress, options=o, callback=callback)
-        for p, o in zip(panels, own, strict=True)
+        solve(p.mesh, material, thickness, prestress=s, options=o, callback=callback)
+        for p, o, s in zip(panels, own, stresses, strict=True)
     ]
     independent = float(sum(r.energy for r in results))
     before = [seam_lengths([r.material_coordinates for r in results], s) for s in seams]
