@@ -23,7 +23,13 @@ from ..io.meshes import write_surface
 if TYPE_CHECKING:
     from ..analysis.erection_optimum import OptimisedPatterns
 
-__all__ = ["ERECTION_FILES", "erected_pictures", "erection_files", "write_erection"]
+__all__ = [
+    "ERECTION_FILES",
+    "erected_pictures",
+    "erection_comparison",
+    "erection_files",
+    "write_erection",
+]
 
 #: The files of an erection, in the output directory's ``erect/``.
 ERECTION_FILES = (
@@ -35,6 +41,60 @@ ERECTION_FILES = (
     "fill_stress.png",
     "state.png",
 )
+
+
+def _number(value: float, digits: int = 4) -> str:
+    return f"{value:.{digits}g}"
+
+
+def erection_comparison(
+    result: ErectionResult, units: str, optimum: OptimisedPatterns | None = None
+) -> tuple[list[str], list[tuple[str, ...]]]:
+    """The figures an erection is judged by, column by column: on the design shape, after
+    erection (with ``optimum``: the VaReS patterns' erection, then the optimised patterns'):
+    ``(column titles, rows of (label, value per column))`` for the command line and reports."""
+    columns = [
+        (
+            "optimised, on the design shape" if optimum is not None else "on the design shape",
+            result.statistics(design=True),
+            None,
+            result.surface_area,
+        )
+    ]
+    if optimum is not None:
+        start = optimum.start
+        columns.append(
+            ("VaReS patterns, erected", start.statistics(), start.deviation(), start.erected_area)
+        )
+        columns.append(
+            ("optimised, erected", result.statistics(), result.deviation(), result.erected_area)
+        )
+    else:
+        columns.append(
+            ("after erection", result.statistics(), result.deviation(), result.erected_area)
+        )
+    rows: list[tuple[str, ...]] = []
+    for yarn in ("warp", "fill"):
+        stats = [c[1]["stress"][yarn] for c in columns]
+        rows += [
+            (f"{yarn}: intended", *(_number(s["intended"]) for s in stats)),
+            (f"{yarn}: mean", *(_number(s["mean"]) for s in stats)),
+            (f"{yarn}: min … max", *(f"{_number(s['min'])} … {_number(s['max'])}" for s in stats)),
+            (f"{yarn}: RMS from intended", *(_number(s["rms_deviation"], 3) for s in stats)),
+        ]
+    for key, label in (("wrinkled", "wrinkled area (uniaxial tension)"), ("slack", "slack area")):
+        rows.append((label, *(f"{100 * c[1][f'{key}_area_fraction']:.1f} %" for c in columns)))
+    rows.append(
+        (
+            f"normal deviation, max / RMS ({units})",
+            *(
+                "0 / 0" if d is None else f"{_number(d['max'], 3)} / {_number(d['rms'], 3)}"
+                for _, _, d, _ in columns
+            ),
+        )
+    )
+    rows.append((f"area ({units}²)", *(_number(a, 6) for *_, a in columns)))
+    return [c[0] for c in columns], rows
 
 
 def erection_files(directory: Path, report: bool = False) -> list[Path]:

@@ -9,10 +9,11 @@ It goes into a job's ``report.html`` (the pattern's, or the structure's) when th
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..analysis.erection import ErectionResult
 from ..io.files import write_text
-from .erection_outputs import erected_pictures
+from .erection_outputs import erected_pictures, erection_comparison
 from .html_parts import (
     REPORT_DPI,
     figure,
@@ -24,50 +25,10 @@ from .html_parts import (
     table,
 )
 
+if TYPE_CHECKING:
+    from ..analysis.erection_optimum import OptimisedPatterns
+
 __all__ = ["erection_section", "write_erection_report"]
-
-
-def _comparison_rows(result: ErectionResult, units: str) -> list[tuple[str, str, str]]:
-    design, after = result.statistics(design=True), result.statistics()
-    rows = []
-    for yarn in ("warp", "fill"):
-        d, a = design["stress"][yarn], after["stress"][yarn]
-        rows += [
-            (f"{yarn}: intended prestress", number(d["intended"]), number(a["intended"])),
-            (f"{yarn}: mean", number(d["mean"]), number(a["mean"])),
-            (
-                f"{yarn}: min … max",
-                f"{number(d['min'])} … {number(d['max'])}",
-                f"{number(a['min'])} … {number(a['max'])}",
-            ),
-            (
-                f"{yarn}: RMS deviation from intended",
-                number(d["rms_deviation"], 3),
-                number(a["rms_deviation"], 3),
-            ),
-        ]
-    for key, label in (("wrinkled", "wrinkled area (uniaxial tension)"), ("slack", "slack area")):
-        rows.append(
-            (
-                label,
-                f"{100 * design[f'{key}_area_fraction']:.1f} %",
-                f"{100 * after[f'{key}_area_fraction']:.1f} %",
-            )
-        )
-    deviation = result.deviation()
-    rows += [
-        (
-            "normal deviation, max / RMS",
-            "0 / 0",
-            f"{number(deviation['max'], 3)} / {number(deviation['rms'], 3)} {units}",
-        ),
-        (
-            "area",
-            f"{number(result.surface_area)} {units}²",
-            f"{number(result.erected_area)} {units}²",
-        ),
-    ]
-    return rows
 
 
 def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[str]:
@@ -122,9 +83,15 @@ def _figures(result: ErectionResult, units: str, pictures: Path | None) -> list[
     return out
 
 
-def erection_section(result: ErectionResult, units: str, pictures: Path | None = None) -> list[str]:
-    """The section: status, comparison table (force per length), figures (those in
-    ``pictures``, the erection's folder, embedded as they are)."""
+def erection_section(
+    result: ErectionResult,
+    units: str,
+    pictures: Path | None = None,
+    optimum: OptimisedPatterns | None = None,
+) -> list[str]:
+    """The section: status, comparison table (force per length; with ``optimum``, the VaReS
+    patterns' erection beside the optimised patterns'), figures (those in ``pictures``, the
+    erection's folder, embedded as they are)."""
     key = [
         ("status", "converged" if result.converged else f"not converged: {result.reason}"),
         ("panels welded", len(result.panels)),
@@ -135,6 +102,16 @@ def erection_section(result: ErectionResult, units: str, pictures: Path | None =
         ("Newton iterations", result.iterations),
         ("time", f"{result.elapsed:.2f} s"),
     ]
+    if optimum is not None:
+        key.append(
+            (
+                "patterns optimised for the erected structure",
+                f"{optimum.iterations} steps, {optimum.elapsed:.2f} s (shape weight "
+                f"{optimum.shape_weight:g}, shape bound {optimum.shape_bound}"
+                + ("" if optimum.converged else f"; not optimised: {optimum.reason}")
+                + ")",
+            )
+        )
     if result.cables is not None:
         key.append(
             (
@@ -153,12 +130,9 @@ def erection_section(result: ErectionResult, units: str, pictures: Path | None =
         table(key, ident="erection"),
     ]
     if result.converged:
+        titles, rows = erection_comparison(result, units, optimum)
         parts += [
-            table(
-                _comparison_rows(result, units),
-                header=("", "on the design shape", "after erection"),
-                ident="erection-comparison",
-            ),
+            table(rows, header=("", *titles), ident="erection-comparison"),
             *_figures(result, units, pictures),
         ]
     return parts

@@ -256,7 +256,9 @@ def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
         parts += _pattern_figures(panel, material)
     parts += drape_section(panel)
     if outcome.erection is not None and outcome.structure is None:
-        parts += erection_section(outcome.erection, outcome.units, outcome.directory / "erect")
+        parts += erection_section(
+            outcome.erection, outcome.units, outcome.directory / "erect", outcome.optimum
+        )
     files = [(f.name, os.path.relpath(f, panel.directory)) for f in panel.files]
     parts += [
         "<h2>Files</h2>",
@@ -326,7 +328,7 @@ def structure_report(outcome: JobOutcome) -> str:
         ),
         *(_cut_section(outcome) if outcome.cut is not None else []),
         *(
-            erection_section(outcome.erection, units, outcome.directory / "erect")
+            erection_section(outcome.erection, units, outcome.directory / "erect", outcome.optimum)
             if outcome.erection is not None
             else []
         ),

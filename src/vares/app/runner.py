@@ -231,6 +231,10 @@ def _optimise(outcome: JobOutcome, patterns: list[Pattern], options) -> None:
             outcome.structure.results[k] = result
     if outcome.structure is not None:
         outcome.structure.seam_reports = _seam_reports_after(outcome.structure)
+    if outcome.cut is not None:  # the pieces' outlines and the nest of the new patterns
+        from ..structures.cutting import with_patterns
+
+        outcome.cut = with_patterns(outcome.cut, outcome.structure)
 
 
 def _seam_reports_after(structure):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -31,7 +31,7 @@ from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
 from .panels import width_across_warp
 
-__all__ = ["CutResult", "PieceOutline", "SeamLine", "cut"]
+__all__ = ["CutResult", "PieceOutline", "SeamLine", "cut", "with_patterns"]
 
 #: Plans tried at most (each narrower than the last) until every pattern fits the roll.
 MAX_ROUNDS = 3
@@ -162,10 +162,7 @@ def cut(
     started = time.perf_counter()
     scale = unit_factor(dxf_units, units)
     usable = usable_width(cutting.roll_width)
-    allowances = {
-        kind: scale * cutting.allowance(kind, allowance)
-        for kind in ("seam", "free", "cable", "clamp")
-    }
+    allowances = _allowances(cutting, allowance, scale)
     surface = triangulated(mesh)
     target, rounds = usable, []
     for _ in range(MAX_ROUNDS):
@@ -194,17 +191,7 @@ def cut(
             break
         # the flattened widths underestimated the patterns': ask the flattening for less
         target = max(plan.widths) * usable / max(widths) * (1.0 - 1e-3)
-    nest = None
-    if result.converged and max(widths) <= usable:
-        nest = nest_pieces(
-            [o.cut for o in outlines],
-            cutting.roll_width,
-            net_areas=[o.area for o in outlines],
-            allow_turn=cutting.allow_turn,
-            gap=scale * cutting.piece_gap,
-            time_limit=cutting.nest_time,
-            seed=cutting.nest_seed,
-        )
+    nest = _nest(outlines, widths, result, cutting, scale)
     return CutResult(
         plan,
         result,
@@ -220,6 +207,51 @@ def cut(
         rounds,
         time.perf_counter() - started,
         float(min_angles(surface.points, surface.cells["triangle"]).min()),
+    )
+
+
+def _allowances(cutting: CutOptions, allowance: float, scale: float) -> dict[str, float]:
+    """The allowance of every kind of edge, mesh units."""
+    return {
+        kind: scale * cutting.allowance(kind, allowance)
+        for kind in ("seam", "free", "cable", "clamp")
+    }
+
+
+def _nest(outlines, widths, result: StructureResult, cutting: CutOptions, scale: float):
+    """The pieces nested on the roll, or None where they are not patterns or too wide."""
+    if not result.converged or max(widths) > usable_width(cutting.roll_width):
+        return None
+    return nest_pieces(
+        [o.cut for o in outlines],
+        cutting.roll_width,
+        net_areas=[o.area for o in outlines],
+        allow_turn=cutting.allow_turn,
+        gap=scale * cutting.piece_gap,
+        time_limit=cutting.nest_time,
+        seed=cutting.nest_seed,
+    )
+
+
+def with_patterns(cut_result: CutResult, structure: StructureResult) -> CutResult:
+    """The cut with other patterns of its strips (e.g. optimised for the erected structure):
+    outlines, widths, seams and the nest made again from ``structure``'s."""
+    cutting = cut_result.options
+    scale = unit_factor(cut_result.dxf_units, cut_result.units)
+    allowances = _allowances(cutting, cut_result.allowance, scale)
+    outlines = piece_outlines(cut_result.plan.cut, structure, cutting, allowances)
+    widths = [
+        width_across_warp(o.cut, r.fibres.warp)
+        for o, r in zip(outlines, structure.results, strict=True)
+    ]
+    nest = _nest(outlines, widths, structure, cutting, scale)
+    return replace(
+        cut_result,
+        structure=structure,
+        outlines=outlines,
+        widths=widths,
+        seams=seam_lines(cut_result.plan, structure),
+        nest=nest,
     )
 
 

@@ -18,6 +18,7 @@ if TYPE_CHECKING:  # the engine is imported when a command runs, not to build th
     import numpy as np
 
     from ...analysis.erection import ErectionResult
+    from ...analysis.erection_optimum import OptimisedPatterns
     from ...solver.result import IterationRecord
     from ..job import Job
     from ..outcome import JobOutcome, PanelOutcome
@@ -204,47 +205,36 @@ def _show_cut(outcome: JobOutcome) -> None:
         )
 
 
-def show_erection(result: ErectionResult, units: str) -> None:
-    """Print what an erection did: status, and design shape against erected."""
+def show_erection(
+    result: ErectionResult, units: str, optimum: OptimisedPatterns | None = None
+) -> None:
+    """Print what an erection did: status, and design shape against erected (with ``optimum``,
+    the VaReS patterns' erection beside the optimised patterns')."""
     status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
     console.print(
         f"erection of {len(result.panels)} panel(s), {result.mesh.num_points} nodes "
         f"({int(result.held.sum())} held): {status} in {result.iterations} iterations, "
         f"{result.elapsed:.2f} s"
     )
+    if optimum is not None:
+        console.print(
+            f"patterns optimised for the erected structure: {optimum.iterations} steps, "
+            f"{optimum.elapsed:.2f} s"
+            + ("" if optimum.converged else f" ([red]not optimised[/]: {optimum.reason})")
+        )
     if not result.converged:
         return
+    from ..erection_outputs import erection_comparison
+
+    titles, rows = erection_comparison(result, units, optimum)
     table = Table(
         "",
-        "on the design shape",
-        "after erection",
+        *titles,
         title="membrane forces (force/length; means and RMS weighted by the design area)",
     )
-    design, after = result.statistics(design=True), result.statistics()
-    for yarn in ("warp", "fill"):
-        d, a = design["stress"][yarn], after["stress"][yarn]
-        table.add_row(f"{yarn} intended", f"{d['intended']:.4g}", f"{a['intended']:.4g}")
-        table.add_row(f"{yarn} mean", f"{d['mean']:.4g}", f"{a['mean']:.4g}")
-        table.add_row(
-            f"{yarn} min … max",
-            f"{d['min']:.4g} … {d['max']:.4g}",
-            f"{a['min']:.4g} … {a['max']:.4g}",
-        )
-        table.add_row(
-            f"{yarn} RMS from intended", f"{d['rms_deviation']:.3g}", f"{a['rms_deviation']:.3g}"
-        )
-    for key in ("wrinkled", "slack"):
-        table.add_row(
-            f"{key} area",
-            f"{100 * design[f'{key}_area_fraction']:.1f} %",
-            f"{100 * after[f'{key}_area_fraction']:.1f} %",
-        )
+    for row in rows:
+        table.add_row(*row)
     console.print(table)
-    deviation = result.deviation()
-    console.print(
-        f"normal deviation from the design: max {deviation['max']:.3g} {units}, "
-        f"RMS {deviation['rms']:.3g} {units}"
-    )
 
 
 def show(outcome: JobOutcome) -> None:
@@ -263,7 +253,7 @@ def show(outcome: JobOutcome) -> None:
             f"{p.name}: {w}" for p in outcome.panels for w in p.warnings if w not in warnings
         ]
     if outcome.erection is not None:
-        show_erection(outcome.erection, outcome.units)
+        show_erection(outcome.erection, outcome.units, outcome.optimum)
     for warning in warnings:
         console.print(f"[yellow]warning:[/] {warning}")
     for path in outcome.files:
