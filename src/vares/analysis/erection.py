@@ -47,6 +47,12 @@ ROUND_OFF_REGIME = 1e-11
 #: With the tension field, the line search hands over to damped steps when the residual has not
 #: halved in this many iterations (Newton's steps circling a solution where cells switch state).
 STALL_WINDOW = 10
+#: What an erection held back by folding cells says.
+SQUEEZED_MEMBRANE = (
+    "the erected membrane is being folded over at {cells}: the patterns are far from fitting "
+    "their supports there (a pattern much too large or too small for its boundary), or the "
+    "start folds them"
+)
 _ATTEMPTS = (Attempt("erection", None, "line-search"), Attempt("erection, damped", None, "damped"))
 
 
@@ -318,6 +324,7 @@ def _context(
         round_off_regime=ROUND_OFF_REGIME,
         loosest_forcing=ETA_MAX_KINKED if problem.wrinkling else ETA_MAX,
         stall_window=STALL_WINDOW if problem.wrinkling else None,
+        squeezed=SQUEEZED_MEMBRANE,
     )
 
 

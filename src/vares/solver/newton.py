@@ -44,6 +44,12 @@ EXACT_TANGENT_BELOW = 1e-2
 #: mean it has reached the round-off floor of the mesh (ill-shaped cells make the floor higher
 #: than a tight tolerance): the iteration stops there (see :func:`at_round_off`).
 ROUND_OFF_REGIME = 1e-6
+#: A pattern squeezed flat (:class:`NewtonContext`'s ``squeezed``).
+SQUEEZED_PATTERN = (
+    "the pattern is being squeezed flat at {cells}: the energy's minimum would fold them (the "
+    "pattern would lap over itself there); cut the surface there (split it into panels) or add "
+    "a dart"
+)
 #: ``"full"``: plain Newton; ``"line-search"``: globalised; ``"damped"``: Levenberg–Marquardt.
 METHODS = ("full", "line-search", "damped")
 
@@ -108,6 +114,9 @@ class NewtonContext:
     #: kinks can keep Newton's steps circling the solution (cells switching state at every
     #: iteration) where damped steps settle it.
     stall_window: int | None = None
+    #: What a line search held back by a fold for :data:`SQUEEZED_ITERATIONS` iterations says
+    #: (``{cells}``: the cells).
+    squeezed: str = SQUEEZED_PATTERN
 
     def __post_init__(self) -> None:
         #: the linear solver, reusing its factorisations where that is cheaper (inexact Newton)
@@ -284,11 +293,7 @@ def newton(
             squeezed = squeezed + 1 if _held_back(search, step_length, step_lengths) else 0
             if squeezed >= SQUEEZED_ITERATIONS:
                 raise Failure(
-                    f"the pattern is being squeezed flat at {describe_cells(search.bounded_by)}: "
-                    "the energy's minimum would fold them (the pattern would lap over itself "
-                    "there); cut the surface there (split it into panels) or add a dart",
-                    x,
-                    folding=True,
+                    ctx.squeezed.format(cells=describe_cells(search.bounded_by)), x, folding=True
                 )
     raise AssertionError("unreachable")
 
