@@ -130,3 +130,27 @@ def test_a_stalled_line_search_hands_over_to_damped_steps():
     circling = [*falling[:10], *([3e-5, 1e-5] * 6)]
     assert _stalled(circling, 10)
     assert not _stalled(circling[:12], 10)  # too few iterations to tell
+
+
+def test_where_slack_regions_leave_no_isolated_equilibrium_the_regularised_one_is_found():
+    """A hypar cut for an isotropic prestress whose pattern leaves a large part of the design
+    in compression: erected, a quarter of it wrinkles and some hangs slack, where the tension
+    field's equilibria are not isolated. Newton's method on the law stalls there and the
+    equilibrium of the regularised energy (the film's tension in it) is returned, said so, and
+    the law's residual there is no more than the film's forces."""
+    from vares.analysis.erection import _film_residual
+
+    mesh = vares.examples.hypar(n=16)
+    pattern = vares.solve(mesh, NeoHooke(E=1000.0, nu=0.3), prestress=2.0)
+    result = vares.erect(pattern)
+    assert result.converged and result.regularised
+    assert result.strategy[0] == "erection" and "regularised" in result.strategy[-1]
+    stats = result.statistics()
+    assert stats["wrinkled_area_fraction"] > 0.1 and stats["slack_area_fraction"] > 0.01
+    problem, ctx = result.problem, result.context
+    evaluation = problem.evaluate(result.erected_points, order=1)
+    law = np.linalg.norm(ctx.residual(ctx.assembler.vector(evaluation.gradients)))
+    film = _film_residual(problem, result.erected_points, ctx)
+    assert 0 < law <= 1.01 * film + ctx.residual_tolerance
+    assert result.to_dict()["regularised"] is True
+    assert not vares.erect(taut_hypar()).regularised

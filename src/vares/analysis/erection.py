@@ -54,6 +54,7 @@ SQUEEZED_MEMBRANE = (
     "start folds them"
 )
 _ATTEMPTS = (Attempt("erection", None, "line-search"), Attempt("erection, damped", None, "damped"))
+_REGULARISED = tuple(Attempt(f"{a.name}, regularised", a.taus, a.method) for a in _ATTEMPTS)
 
 
 @dataclass
@@ -83,6 +84,11 @@ class ErectionResult:
     panels, node_maps, cell_ids
         Panel names; per panel, the welded node of each of its nodes and the welded cell of each
         of its cells (its own cell order).
+    regularised
+        Newton's method on the law itself stalled (where cells wrinkle or hang slack the
+        tension field's equilibria are not isolated), and the state is the equilibrium of the
+        regularised energy (the film's tension in it, module docs of
+        :mod:`vares.mechanics.erection`): the law's residual there is the film's forces.
     problem, structure, context
         The forward problem, the welded structure and the Newton context it was solved with
         (what the sensitivities of :mod:`vares.analysis.erection_optimum` build on).
@@ -112,6 +118,7 @@ class ErectionResult:
     panels: list[str] = field(default_factory=list)
     node_maps: list[np.ndarray] = field(default_factory=list)
     cell_ids: list[np.ndarray] = field(default_factory=list)
+    regularised: bool = False
     problem: ErectionProblem | None = field(default=None, repr=False, compare=False)
     structure: Structure | None = field(default=None, repr=False, compare=False)
     context: NewtonContext | None = field(default=None, repr=False, compare=False)
@@ -157,6 +164,7 @@ class ErectionResult:
             "converged": self.converged,
             "reason": self.reason,
             "iterations": self.iterations,
+            "regularised": self.regularised,
             "units": units,
             "surface_area": self.surface_area,
             "erected_area": self.erected_area,
@@ -245,14 +253,18 @@ def erect(
         inverted = problem.inverted_cells(x)
         if inverted.size:
             reason = f"the start turns {describe_cells(inverted)} over"
+    regularised = False
     if reason is None:
         try:
-            x, path, reason = follow_plan(problem, x, None, _ATTEMPTS, ctx, damping=1.0)
+            x, path, reason, regularised = _settle(problem, x, ctx)
         except WrinklingError as exc:
             reason = str(exc)
+    problem.film_in_energy = False  # the law's forces, whichever problem was solved
     fields = _fields(problem, x, structure, relaxed=options.wrinkling)
     if reason is None:
-        reason = _not_in_equilibrium(problem, x, ctx, taut=not fields["state"].any())
+        reason = _not_in_equilibrium(
+            problem, x, ctx, taut=not fields["state"].any(), film=regularised
+        )
     normals, node_areas = node_normals(mesh)
     return ErectionResult(
         mesh=mesh,
@@ -282,7 +294,23 @@ def erect(
         problem=problem,
         structure=structure,
         context=ctx,
+        regularised=regularised,
     )
+
+
+def _settle(problem: ErectionProblem, x: np.ndarray, ctx: NewtonContext):
+    """Newton's method on the law itself (the film in the tangent only); where it stalls (the
+    tension field's equilibria are not isolated where cells wrinkle or hang slack: Newton's steps
+    circle them), on the regularised energy with the film in it, from where it stopped:
+    ``(x, attempts, reason of failure or None, regularised)``."""
+    fallback = problem.wrinkling and problem.tension > 0
+    first = _ATTEMPTS[:1] if fallback else _ATTEMPTS
+    x, path, reason = follow_plan(problem, x, None, first, ctx, damping=1.0)
+    if reason is None or not fallback:
+        return x, path, reason, False
+    problem.film_in_energy = True
+    x, more, reason = follow_plan(problem, x, None, _REGULARISED, ctx, damping=1.0)
+    return x, path + more, reason, True
 
 
 def _defaults(source, material, thickness, solver):
@@ -328,11 +356,16 @@ def _context(
     )
 
 
-def _not_in_equilibrium(problem: ErectionProblem, x, ctx: NewtonContext, taut: bool) -> str | None:
+def _not_in_equilibrium(
+    problem: ErectionProblem, x, ctx: NewtonContext, taut: bool, film: bool = False
+) -> str | None:
     """Why ``x`` is no equilibrium, or None: the residual of the energy solved for (the relaxed
     law's) and, where no cell wrinkles or hangs slack, that of the law as it is (the two agree
-    there) must be within the tolerance, or the round-off floor Newton's method stopped at."""
+    there) must be within the tolerance, or the round-off floor Newton's method stopped at; with
+    ``film`` (the regularised energy was solved), within that plus the film's own forces."""
     bound = max(ctx.residual_tolerance, ctx.round_off_regime * ctx.force_scale)
+    if film:
+        bound += 1.01 * _film_residual(problem, x, ctx)
     laws = [problem.wrinkling] + ([False] if taut and problem.wrinkling else [])
     for relaxed in laws:
         evaluation = problem.evaluate(x, order=1, relaxed=relaxed)
@@ -345,6 +378,17 @@ def _not_in_equilibrium(problem: ErectionProblem, x, ctx: NewtonContext, taut: b
                 f"{bound / ctx.force_scale:.3g})"
             )
     return None
+
+
+def _film_residual(problem: ErectionProblem, x, ctx: NewtonContext) -> float:
+    """The norm of the film's nodal forces at ``x`` (free dofs)."""
+    forces = []
+    for in_energy in (True, False):
+        problem.film_in_energy = in_energy
+        evaluation = problem.evaluate(x, order=1)
+        forces.append(ctx.residual(ctx.assembler.vector(evaluation.gradients)))
+    problem.film_in_energy = False
+    return float(np.linalg.norm(forces[0] - forces[1]))
 
 
 def _checked_start(start, design: np.ndarray) -> np.ndarray:

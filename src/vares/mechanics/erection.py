@@ -148,6 +148,9 @@ class ErectionProblem:
         self.reference_area = float(sum(b.reference.weights.sum() for b in blocks)) / thickness
         self._wrinkles: dict[int, np.ndarray] = {}  # per block: the wrinkles last found
         self._film = [self._film_hessian(b) for b in blocks] if self.tension > 0 else None
+        #: the film in the energy too (a regularised problem, whose slack regions hang taut at
+        #: the film's tension), or in the tangent only (module docs)
+        self.film_in_energy = False
 
     def _film_hessian(self, block: MembraneBlock) -> np.ndarray:
         """The film's Hessian ``(m, nen, 3, nen, 3)``: the same for every ``x``."""
@@ -174,7 +177,10 @@ class ErectionProblem:
                     self._wrinkles[block] = r.wrinkle
             else:
                 r = self.material.response(C, fibres, tangent=tangent)
-            return r.psi, r.stress, r.tangent
+            if not self.film_in_energy:
+                return r.psi, r.stress, r.tangent
+            psi = r.psi + 0.5 * self.tension * (C[..., 0, 0] + C[..., 1, 1] - 2.0)
+            return psi, r.stress + self.tension * np.eye(2), r.tangent
 
         return respond
 
@@ -198,7 +204,12 @@ class ErectionProblem:
             energies.append(result.energy)
             total += np.sum(result.energy).real
             gradient, hessian = result.gradient, result.hessian
-            if hessian is not None and self._film is not None and stabilised:
+            if (
+                hessian is not None
+                and self._film is not None
+                and stabilised
+                and not self.film_in_energy
+            ):
                 hessian = hessian + self._film[index]
             if self.pressure:
                 load = pressure_terms(nodes, self.pressure, order)
@@ -235,7 +246,7 @@ class ErectionProblem:
             forward_projected_hessian(b.reference, h)
             for b, h in zip(self.blocks, evaluation.jacobian_hessians, strict=True)
         ]
-        if self._film is not None:
+        if self._film is not None and not self.film_in_energy:
             out = [h + film for h, film in zip(out, self._film, strict=True)]
         if evaluation.cable_hessian is not None:
             out.append(evaluation.cable_hessian)
