@@ -157,8 +157,8 @@ def plan_strips(
             count -= 1
         elif fits:
             break
-        else:
-            count += 1
+        else:  # as many more as the widest strip is too wide (then back down, one at a time)
+            count = max(count + 1, math.ceil(count * max(plan.widths) / width))
     best = min((c for c, p in tried.items() if max(p.widths) <= width), default=None)
     if best is None:
         raise CuttingError(f"no layout of up to {max(tried)} strips fits the roll width {width:g}")
