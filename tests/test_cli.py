@@ -499,3 +499,17 @@ def test_plot_writes_each_field_on_the_pattern_and_the_surface(tmp_path):
     # one figure re-coloured field after field: the second picture is its own, not the first's
     assert pictures["det_F"].shape == pictures["warp_stress"].shape
     assert (pictures["det_F"] != pictures["warp_stress"]).any(axis=-1).mean() > 0.05
+
+
+def test_the_iterations_a_run_reports_are_those_the_limit_bounds_per_solve(tmp_path):
+    """--max-iterations bounds each attempt and pseudo-time step; the run's line says so: the
+    total, and the limit with the number of solves it bounded (a sail with a limit of 2 falls
+    back to pseudo-time stepping with its steps cut back)."""
+    result = run("example", "sail", "-o", tmp_path / "s", "--max-iterations", "2")
+    assert result.exit_code == 0, result.stderr
+    line = next(x for x in result.stderr.splitlines() if x.startswith("sail: converged"))
+    summary = json.loads((tmp_path / "s" / "summary.json").read_text())
+    total = summary["iterations"]
+    assert f"in {total} Newton iterations" in line and "at most 2 in each of" in line
+    solves = int(line.split("at most 2 in each of ")[1].split(")")[0])
+    assert total <= 2 * solves

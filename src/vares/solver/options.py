@@ -90,7 +90,8 @@ class SolveOptions(Options):
     max_iterations: int = option(
         50,
         "int",
-        "Newton iterations per step (and of seam matching).",
+        "Newton iterations of each attempt of the strategy and each pseudo-time step (and of "
+        "seam matching); a run reports the iterations of all its attempts and steps together.",
         section="solver",
         minimum=1,
     )

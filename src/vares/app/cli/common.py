@@ -138,10 +138,13 @@ def _seconds(result) -> str:
 def _show_panel(panel: PanelOutcome, detail: bool) -> None:
     result = panel.result
     status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
+    solves = len(result.steps)
+    per = f", at most {result.options.max_iterations} in each of {solves}" if solves > 1 else ""
     console.print(
-        f"{panel.name}: {status} in {result.iterations} iterations "
-        f"({' → '.join(result.strategy)}), {_seconds(result)}; energy {result.energy:.6e}; "
-        f"area 3D {result.surface_area:.6g}, pattern {result.pattern_area:.6g}"
+        f"{panel.name}: {status} in {result.iterations} Newton iterations "
+        f"({' → '.join(result.strategy)}{per}), {_seconds(result)}; energy "
+        f"{result.energy:.6e}; area 3D {result.surface_area:.6g}, pattern "
+        f"{result.pattern_area:.6g}"
     )
     if result.converged and detail:
         console.print(field_table(result.fields))
