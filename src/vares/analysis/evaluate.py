@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.mesh import SurfaceMesh, _listing
+from ..geometry.mesh import SurfaceMesh, index_listing
 from ..materials import Fibres, Hyperelastic
 from ..mechanics.fields import cell_fields
 from ..mechanics.problem import Problem
@@ -65,7 +65,7 @@ def evaluate(
     bad = np.flatnonzero(~np.isfinite(coordinates).all(axis=1))
     if bad.size:
         raise ValueError(
-            f"the pattern's coordinates are not finite (NaN or inf) at nodes {_listing(bad)}"
+            f"the pattern's coordinates are not finite (NaN or inf) at nodes {index_listing(bad)}"
         )
     fibres = Fibres.from_angles(warp_angle, fill_angle)
     problem = Problem(mesh, material, thickness, fibres=fibres, prestress=prestress)

@@ -19,15 +19,16 @@ from scipy.sparse.csgraph import connected_components
 
 from .elements import ELEMENTS
 
-__all__ = ["MeshError", "SurfaceMesh", "connected_pieces", "corner_fans"]
+__all__ = ["MeshError", "SurfaceMesh", "connected_pieces", "corner_fans", "index_listing"]
 
 
 class MeshError(ValueError):
     """The input is not a surface that can be patterned; the message names cells or nodes."""
 
 
-def _listing(indices: np.ndarray, limit: int = 8) -> str:
-    """Render the first few offending indices for an error message."""
+def index_listing(indices: np.ndarray, limit: int = 8) -> str:
+    """The first ``limit`` of ``indices`` (nodes or cells) for an error message, with the count
+    when there are more: ``"3, 7, 9, … (12 in all)"``."""
     indices = np.asarray(indices).ravel()
     shown = ", ".join(str(int(i)) for i in indices[:limit])
     more = f", … ({indices.size} in all)" if indices.size > limit else ""
@@ -68,7 +69,7 @@ class SurfaceMesh:
             raise MeshError("the mesh has no points")
         bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
         if bad.size:
-            raise MeshError(f"non-finite coordinates (NaN or inf) at nodes {_listing(bad)}")
+            raise MeshError(f"non-finite coordinates (NaN or inf) at nodes {index_listing(bad)}")
 
         clean: dict[str, np.ndarray] = {}
         for cell_type, block in cells.items():
@@ -98,7 +99,8 @@ class SurfaceMesh:
             out = np.flatnonzero(((arr < 0) | (arr >= num_points)).any(axis=1))
             if out.size:
                 raise MeshError(
-                    f"{cell_type} cells {_listing(out)} refer to nodes outside 0..{num_points - 1}"
+                    f"{cell_type} cells {index_listing(out)} refer to nodes outside "
+                    f"0..{num_points - 1}"
                 )
 
         used = np.zeros(num_points, dtype=bool)
@@ -109,11 +111,11 @@ class SurfaceMesh:
             unused = np.flatnonzero(~used)
             if not drop_unused_nodes:
                 raise MeshError(
-                    f"nodes {_listing(unused)} belong to no cell "
+                    f"nodes {index_listing(unused)} belong to no cell "
                     "(pass drop_unused_nodes=True to remove them)"
                 )
             warnings.warn(
-                f"dropped {unused.size} node(s) that belong to no cell: {_listing(unused)}",
+                f"dropped {unused.size} node(s) that belong to no cell: {index_listing(unused)}",
                 stacklevel=2,
             )
             node_map = np.flatnonzero(used)
@@ -235,7 +237,7 @@ class SurfaceMesh:
         for t, a, offset in self._global_cells():
             mine = global_ids[(global_ids >= offset) & (global_ids < offset + len(a))] - offset
             if mine.size:
-                parts.append(f"{t} cells {_listing(np.unique(mine))}")
+                parts.append(f"{t} cells {index_listing(np.unique(mine))}")
         return "; ".join(parts)
 
     def _edge_table(self) -> _EdgeTable:
@@ -251,13 +253,13 @@ class SurfaceMesh:
         for t, a, _ in self._global_cells():
             repeated = np.flatnonzero((np.diff(np.sort(a, axis=1), axis=1) == 0).any(axis=1))
             if repeated.size:
-                raise MeshError(f"degenerate {t} cells {_listing(repeated)} repeat a node")
+                raise MeshError(f"degenerate {t} cells {index_listing(repeated)} repeat a node")
             # Smallest corner parallelogram area of each cell, relative to the model size.
             corner = ELEMENTS[t].corner_areas(points, a).min(axis=1)
             flat = np.flatnonzero(corner <= 1e-12 * scale**2)
             if flat.size:
                 raise MeshError(
-                    f"degenerate {t} cells {_listing(flat)} have (nearly) zero area "
+                    f"degenerate {t} cells {index_listing(flat)} have (nearly) zero area "
                     "or collinear corners"
                 )
 
@@ -304,7 +306,7 @@ class SurfaceMesh:
             sizes = np.bincount(label)
             raise MeshError(
                 f"the mesh has {num_pieces} separate pieces (cells per piece: "
-                f"{_listing(sizes)}); pattern them as the panels of a structure: "
+                f"{index_listing(sizes)}); pattern them as the panels of a structure: "
                 "'vares panels FILE' takes each piece as a panel"
             )
 
@@ -321,7 +323,7 @@ class SurfaceMesh:
         bow_tie = np.flatnonzero(fans_per_node > 1)
         if bow_tie.size:
             raise MeshError(
-                f"non-manifold nodes {_listing(self._node_map[bow_tie])}: the cells around "
+                f"non-manifold nodes {index_listing(self._node_map[bow_tie])}: the cells around "
                 "each of them form separate fans that touch only at the node (reading the file "
                 "with repair on splits such nodes)"
             )

@@ -27,7 +27,7 @@ from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from .elements import ELEMENTS
-from .mesh import MeshError, _EdgeTable, _listing, corner_fans
+from .mesh import MeshError, _EdgeTable, corner_fans, index_listing
 from .weld import coincident_nodes
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
@@ -111,7 +111,7 @@ def repair(
     points = np.asarray(points, dtype=float)
     bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
     if bad.size:
-        raise MeshError(f"non-finite coordinates (NaN or inf) at nodes {_listing(bad)}")
+        raise MeshError(f"non-finite coordinates (NaN or inf) at nodes {index_listing(bad)}")
     blocks, owners, start = {}, {}, 0
     for cell_type, block in cells.items():
         block = np.asarray(block, dtype=np.int64).reshape(-1, 3 if cell_type == "triangle" else 4)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.elements import ELEMENTS
-from ..geometry.mesh import MeshError, SurfaceMesh, _listing, connected_pieces
+from ..geometry.mesh import MeshError, SurfaceMesh, connected_pieces, index_listing
 from ..geometry.repair import RepairReport
 from ..geometry.repair import repair as repair_surface
 from ..units import METRES
@@ -369,7 +369,7 @@ def read_pattern(path: Path, mesh: SurfaceMesh) -> np.ndarray:
     if bad.size:
         raise MeshError(
             f"{path}: the pattern's coordinates are not finite (NaN or inf) at nodes "
-            f"{_listing(bad)}"
+            f"{index_listing(bad)}"
         )
     height = np.ptp(points[:, 2]) if points.shape[1] == 3 else 0.0
     if height > 1e-9 * np.ptp(points[:, :2]):
