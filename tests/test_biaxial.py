@@ -424,3 +424,19 @@ def test_fabric_band_command():
     assert "warp length" in result.stderr and "largest node movement" in result.stderr
     result = run("fabric", "band", "--fabric", shipped)
     assert result.exit_code == 2 and "one of a mesh file and --example" in error_line(result)
+
+
+def test_fabric_band_needs_the_scatter_of_the_compensation_values(tmp_path):
+    """A fabric file of one compensation record has no scatter (std 0): its band would be the
+    mean pattern four times over, presented as a band of zero width; it is refused instead."""
+    shipped = Path(__file__).parent.parent / "examples" / "biaxial"
+    single = tmp_path / "single.toml"
+    result = run(
+        "fabric", "fit", shipped / "pes-42-A_msaj.csv", shipped / "pes-42-C_compensation.csv",
+        "--prestress", "2,1.5", "-o", single,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "come from one specimen: their scatter is unknown" in result.stderr
+    refused = run("fabric", "band", "--example", "hypar", "--fabric", single)
+    assert refused.exit_code == 2, refused.stderr
+    assert "no scatter" in error_line(refused) and "1 specimen" in error_line(refused)

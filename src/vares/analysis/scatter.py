@@ -94,11 +94,22 @@ def pattern_band(
 
     ``prestress`` defaults to the one the values were measured at; ``settings`` go to
     :func:`vares.solve` (``warp_direction``, ``orientation``, …). Raises
-    :class:`MaterialError` for a fabric without measured compensation values.
+    :class:`MaterialError` for a fabric without measured compensation values or without their
+    scatter (both standard deviations 0, as from a single specimen).
     """
     c = fabric.compensation
     if c is None:
         raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    if c.warp_std == 0 and c.fill_std == 0:
+        origin = (
+            "warp_std and fill_std are 0 or not given"
+            if c.specimens is None or c.specimens > 1
+            else f"the values of {c.specimens} specimen"
+        )
+        raise MaterialError(
+            f"fabric {fabric.name!r} has no scatter of its compensation values ({origin}): "
+            "its band would be the mean pattern alone; fit two or more compensation records"
+        )
     if not (np.isfinite(sigmas) and sigmas >= 0):
         raise ValueError(f"sigmas must be a number ≥ 0; got {sigmas!r}")
     load = c.prestress if prestress is None else prestress

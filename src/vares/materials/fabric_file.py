@@ -55,13 +55,15 @@ EXTRA_KEYS = {"compensate_by", "scatter", "compensation", "fit", "specimens"}
 @dataclass(frozen=True)
 class MeasuredCompensation:
     """Measured compensation values: warp and fill strains (mm/mm) at the ``prestress``
-    (warp, fill; kN/m), their scatter over the specimens (0 if not given)."""
+    (warp, fill; kN/m), their scatter over the specimens (0 if not given) and the number of
+    specimens (None if not given)."""
 
     prestress: tuple[float, float]
     warp: float
     fill: float
     warp_std: float = 0.0
     fill_std: float = 0.0
+    specimens: int | None = None
 
 
 def read_test_tables(
@@ -98,8 +100,15 @@ def read_test_tables(
         raise MaterialError(f"{where}.compensation: prestress must be two positive numbers")
     if not all(math.isfinite(v) for v in values + scatter):
         raise MaterialError(f"{where}.compensation: values must be finite")
+    if any(v < 0 for v in scatter):
+        raise MaterialError(f"{where}.compensation: warp_std and fill_std must not be negative")
+    specimens = table.get("specimens")
+    if specimens is not None and (
+        isinstance(specimens, bool) or not isinstance(specimens, int) or specimens < 1
+    ):
+        raise MaterialError(f"{where}.compensation: specimens must be a positive integer")
     compensation = MeasuredCompensation(
-        (pair[0], pair[1]), values[0], values[1], scatter[0], scatter[1]
+        (pair[0], pair[1]), values[0], values[1], scatter[0], scatter[1], specimens
     )
     return compensation, choice
 

@@ -210,6 +210,19 @@ def _show(fitted: "FabricFit") -> None:
         if law is not None:
             values.add_row("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %")
         console.print(values)
+    single = [
+        what
+        for what, summary in (
+            ("constants", fitted.constants),
+            ("compensation values", fitted.compensation),
+        )
+        if summary is not None and summary.specimens == 1
+    ]
+    if single:
+        console.print(
+            f"the {' and the '.join(single)} come from one specimen: their scatter is unknown "
+            "(written as 0); a band (vares fabric band) needs two or more"
+        )
 
 
 @fabric_app.command("band")
