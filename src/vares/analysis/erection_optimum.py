@@ -57,8 +57,8 @@ INITIAL_DAMPING = 1e-3
 #: No step changes a pattern edge's length by more than this strain.
 MAX_STEP_STRAIN = 0.02
 #: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
-LSQR_TOLERANCE = 1e-4
-LSQR_LIMIT = 60
+LSQR_TOLERANCE = 1e-3
+LSQR_LIMIT = 30
 #: Seam edges are matched again after every step until their lengths differ by at most this
 #: fraction of the patterns' size (at most MATCH_STEPS Gauss–Newton steps).
 MATCHED = 1e-13
