@@ -440,3 +440,17 @@ def test_fabric_band_needs_the_scatter_of_the_compensation_values(tmp_path):
     refused = run("fabric", "band", "--example", "hypar", "--fabric", single)
     assert refused.exit_code == 2, refused.stderr
     assert "no scatter" in error_line(refused) and "1 specimen" in error_line(refused)
+
+
+def test_fabric_file_strings_read_back_as_they_were():
+    """Quotes, backslashes, newlines and other control characters in a record's name or path
+    are escaped: the fabric file stays TOML and reads back the same text."""
+    import tomllib
+
+    from vares.materials.fabric_file import fabric_toml
+
+    odd = 'PES "42"\\A\nline two\ttab\x01\x7f\r'
+    text = fabric_toml("f", {"source": odd}, {"fit": {"note": odd}}, [{"name": odd}])
+    data = tomllib.loads(text)["f"]
+    assert data["source"] == odd and data["fit"]["note"] == odd
+    assert data["specimens"][0]["name"] == odd

@@ -59,6 +59,7 @@ from typing import Any
 
 from ..analysis.drape_options import DrapeOptions
 from ..analysis.options import ErectionOptions
+from ..materials.fabric_file import toml_string
 from ..options import Options, OptionsError, Spec, suggest
 from ..solver.options import SolveOptions
 from ..structures.options import CutOptions, StructureOptions
@@ -245,33 +246,13 @@ def _toml_value(value: Any) -> str:
     raise JobError(f"cannot write {value!r} to a job file")
 
 
-#: The escapes of a TOML basic string; other control characters are written as ``\uXXXX``.
-_TOML_ESCAPES = {
-    "\\": "\\\\",
-    '"': '\\"',
-    "\b": "\\b",
-    "\t": "\\t",
-    "\n": "\\n",
-    "\f": "\\f",
-    "\r": "\\r",
-}
-
-
 def _toml_string(text: str) -> str:
-    """``text`` as a TOML basic string: quoted, with every character TOML does not admit there
-    (quote, backslash, control characters) escaped, so any name or path reads back as it was."""
-    out = []
-    for character in text:
-        code = ord(character)
-        if character in _TOML_ESCAPES:
-            out.append(_TOML_ESCAPES[character])
-        elif code < 0x20 or code == 0x7F:
-            out.append(f"\\u{code:04X}")
-        elif 0xD800 <= code <= 0xDFFF:
-            raise JobError(f"cannot write {text!r} to a job file: it is not valid Unicode")
-        else:
-            out.append(character)
-    return '"' + "".join(out) + '"'
+    """``text`` as an escaped TOML basic string (:func:`~vares.materials.fabric_file.toml_string`)
+    in a job file."""
+    try:
+        return toml_string(text)
+    except ValueError:
+        raise JobError(f"cannot write {text!r} to a job file: it is not valid Unicode") from None
 
 
 def load_job(path: str | Path) -> Job:

@@ -43,7 +43,13 @@ from typing import Any
 
 from .base import MaterialError
 
-__all__ = ["COMPENSATE_BY", "MeasuredCompensation", "fabric_toml", "read_test_tables"]
+__all__ = [
+    "COMPENSATE_BY",
+    "MeasuredCompensation",
+    "fabric_toml",
+    "read_test_tables",
+    "toml_string",
+]
 
 #: How a pattern is compensated with a tested fabric.
 COMPENSATE_BY = ("measured", "law")
@@ -113,6 +119,36 @@ def read_test_tables(
     return compensation, choice
 
 
+#: The escapes of a TOML basic string; other control characters are written as ``\uXXXX``.
+_TOML_ESCAPES = {
+    "\\": "\\\\",
+    '"': '\\"',
+    "\b": "\\b",
+    "\t": "\\t",
+    "\n": "\\n",
+    "\f": "\\f",
+    "\r": "\\r",
+}
+
+
+def toml_string(text: str) -> str:
+    """``text`` as a TOML basic string: quoted, with every character TOML does not admit there
+    (quote, backslash, control characters) escaped, so any name or path reads back as it was.
+    Raises :class:`ValueError` for text that is not valid Unicode (a lone surrogate)."""
+    out = []
+    for character in text:
+        code = ord(character)
+        if character in _TOML_ESCAPES:
+            out.append(_TOML_ESCAPES[character])
+        elif code < 0x20 or code == 0x7F:
+            out.append(f"\\u{code:04X}")
+        elif 0xD800 <= code <= 0xDFFF:
+            raise ValueError(f"cannot write {text!r} to TOML: it is not valid Unicode")
+        else:
+            out.append(character)
+    return '"' + "".join(out) + '"'
+
+
 def _value(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -124,8 +160,7 @@ def _value(value: Any) -> str:
             return '"nan"'
         return repr(value)
     if isinstance(value, str):
-        text = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", " ")
-        return f'"{text}"'
+        return toml_string(value)
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_value(v) for v in value) + "]"
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
