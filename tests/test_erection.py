@@ -17,7 +17,7 @@ from vares.materials import (
 )
 from vares.mechanics import Assembler
 from vares.mechanics.erection import Cables, ErectionProblem, membrane_block
-from vares.mechanics.forward import _deformation, forward_block, reference_block
+from vares.mechanics.forward import deformation_gradients, forward_block, reference_block
 from vares.mechanics.loads import pressure_terms
 from vares.mechanics.wrinkling import relaxed_response
 
@@ -111,7 +111,7 @@ def test_assembled_forward_residual_and_tangent_by_central_differences(wrinkling
 
 
 def _C(block, x):
-    F = _deformation(x[block.cells], block.reference.gradients)
+    F = deformation_gradients(x[block.cells], block.reference.gradients)
     return np.einsum("mqia,mqib->mqab", F, F)
 
 

@@ -36,7 +36,7 @@ from .erection_fields import erection_statistics, membrane_forces, node_normals
 from .erection_model import Pattern, Structure, build_structure, patterns_of
 from .options import ErectionOptions
 
-__all__ = ["ErectionResult", "Pattern", "erect"]
+__all__ = ["ErectionResult", "Pattern", "erect", "erection_defaults"]
 
 #: Energy changes below this fraction of stiffness × thickness × area are round-off.
 ENERGY_NOISE = 1e-13
@@ -233,7 +233,7 @@ def erect(
     """
     (options,) = split_settings(settings, [options or ErectionOptions()])
     started = time.perf_counter()
-    material, thickness, solver = _defaults(source, material, thickness, solver)
+    material, thickness, solver = erection_defaults(source, material, thickness, solver)
     structure = build_structure(patterns_of(source), thickness, options)
     mesh, design, held = structure.mesh, structure.mesh.points, structure.held
     problem = ErectionProblem(
@@ -313,9 +313,14 @@ def _settle(problem: ErectionProblem, x: np.ndarray, ctx: NewtonContext):
     return x, path + more, reason, True
 
 
-def _defaults(source, material, thickness, solver):
-    """Material, thickness and solver options: as given, or those of the first pattern's
-    solve."""
+def erection_defaults(
+    source: Any,
+    material: Hyperelastic | None,
+    thickness: float | None,
+    solver: SolveOptions | None,
+) -> tuple[Hyperelastic, float, SolveOptions]:
+    """Material, thickness and solver options of an erection of ``source``: as given, or those
+    of the first pattern's solve."""
     first = source if isinstance(source, PatternResult) else getattr(source, "results", source)
     first = first[0] if isinstance(first, list | tuple) else first
     solved = isinstance(first, PatternResult)

@@ -420,9 +420,9 @@ def optimise_for_erection(
     iterations = options.optimise_iterations
     patterns = patterns_of(source)
     if material is None or thickness is None or solver is None:
-        from .erection import _defaults
+        from .erection import erection_defaults
 
-        material, thickness, solver = _defaults(source, material, thickness, solver)
+        material, thickness, solver = erection_defaults(source, material, thickness, solver)
     first = _erect(patterns, material, thickness, solver, options, None)
     if not first.converged:
         return OptimisedPatterns(

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..mechanics.erection import ErectionProblem, MembraneBlock
-from ..mechanics.forward import _deformation
+from ..mechanics.forward import deformation_gradients
 
 __all__ = ["BlockDerivatives", "block_derivatives", "yarn_force"]
 
@@ -77,7 +77,7 @@ def block_derivatives(problem: ErectionProblem, index: int, x: np.ndarray) -> Bl
     at the erected positions ``x`` ``(n, 3)``, with the problem's law (relaxed or plain)."""
     block: MembraneBlock = problem.blocks[index]
     G, w = block.reference.gradients, block.reference.weights  # (m,q,nen,2), (m,q)
-    F = _deformation(np.ascontiguousarray(x[block.cells]), G)  # (m,q,3,2)
+    F = deformation_gradients(np.ascontiguousarray(x[block.cells]), G)  # (m,q,3,2)
     C = np.swapaxes(F, -1, -2) @ F
     _, S, cc = problem.response(block.fibres, block=index)(C, True)
     S = np.broadcast_to(S, C.shape)

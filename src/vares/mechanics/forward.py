@@ -26,7 +26,13 @@ from numba import njit
 from ..geometry.elements import ReferenceElement, determinant, inverse
 from .kernels import BlockResult, project_psd
 
-__all__ = ["ReferenceBlock", "forward_block", "forward_projected_hessian", "reference_block"]
+__all__ = [
+    "ReferenceBlock",
+    "deformation_gradients",
+    "forward_block",
+    "forward_projected_hessian",
+    "reference_block",
+]
 
 #: ``response(C, tangent) -> (psi, S, ℂ or None)`` at the quadrature points ``(m, q, 2, 2)``.
 Response = Callable[[np.ndarray, bool], tuple[np.ndarray, np.ndarray, np.ndarray | None]]
@@ -62,7 +68,7 @@ def forward_block(
     for ``F_iα``)."""
     dtype = np.result_type(nodes, reference.gradients)
     gradients = reference.gradients.astype(dtype, copy=False)
-    F = _deformation(np.ascontiguousarray(nodes, dtype=dtype), gradients)
+    F = deformation_gradients(np.ascontiguousarray(nodes, dtype=dtype), gradients)
     C = np.swapaxes(F, -1, -2) @ F
     psi, S, tangent = response(C, order >= 2)
     weights = reference.weights.astype(dtype, copy=False)
@@ -94,8 +100,9 @@ def forward_projected_hessian(reference: ReferenceBlock, jacobian_hessian: np.nd
 
 
 @njit(cache=True)
-def _deformation(nodes, gradients):  # pragma: no cover - compiled
-    """``F = Σ_a x_a ⊗ ∇_X N_a`` ``(m, q, 3, 2)``."""
+def deformation_gradients(nodes, gradients):  # pragma: no cover - compiled
+    """``F = Σ_a x_a ⊗ ∇_X N_a`` ``(m, q, 3, 2)`` from the erected nodes ``(m, nen, 3)`` and
+    the shape functions' pattern gradients ``(m, q, nen, 2)``."""
     m, nq, nen = gradients.shape[0], gradients.shape[1], gradients.shape[2]
     F = np.zeros((m, nq, 3, 2), nodes.dtype)
     for e in range(m):
