@@ -10,14 +10,8 @@ from test_erection import flat_panel, jiggled
 import vares
 from vares.analysis import Pattern, erect
 from vares.analysis.erection_model import patterns_of
-from vares.analysis.erection_optimum import (
-    _Layout,
-    _Model,
-    _moved,
-    _seam_edges,
-    optimise_for_erection,
-    optimised_results,
-)
+from vares.analysis.erection_optimum import optimise_for_erection, optimised_results
+from vares.analysis.erection_residuals import PatternLayout, ResidualModel, moved, seam_edges
 from vares.analysis.erection_sensitivity import block_derivatives
 from vares.geometry.elements import ELEMENTS
 from vares.materials import NeoHooke
@@ -118,11 +112,11 @@ def test_jacobian_products_by_finite_differences_and_their_adjoint():
     law = solved.material
     start = erect(patterns, law, 1.0, solver=tight)
     assert not start.fields["state"].any()
-    layout = _Layout(patterns, start)
-    seams = _seam_edges(patterns, start, layout)
+    layout = PatternLayout(patterns, start)
+    seams = seam_edges(patterns, start, layout)
 
     def model(p, e):
-        return _Model(p, e, layout, seams, (1.0, 0.01), 1.0, None, None)
+        return ResidualModel(p, e, layout, seams, (1.0, 0.01), 1.0, None, None)
 
     at = model(patterns, start)
     rng = np.random.default_rng(0)
@@ -130,9 +124,9 @@ def test_jacobian_products_by_finite_differences_and_their_adjoint():
     h = 1e-3
     residuals = []
     for sign in (1.0, -1.0):
-        moved = _moved(patterns, layout.split(sign * h * v))
-        erected = erect(moved, law, 1.0, solver=tight, start=start.erected_points)
-        residuals.append(model(moved, erected).residual)
+        shifted = moved(patterns, layout.split(sign * h * v))
+        erected = erect(shifted, law, 1.0, solver=tight, start=start.erected_points)
+        residuals.append(model(shifted, erected).residual)
     difference = (residuals[0] - residuals[1]) / (2 * h)
     product = at.matvec(v)
     assert np.abs(difference - product).max() < 1e-6 * np.abs(product).max()

@@ -35,19 +35,23 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..materials import Hyperelastic
 from ..mechanics.problem import Problem
 from ..options import split_settings, takes_options
-from ..solver.linear import get_solver
 from ..solver.options import SolveOptions
 from ..solver.result import PatternResult
 from .erection import ErectionResult, erect
-from .erection_fields import node_normals
 from .erection_model import Pattern, patterns_of
-from .erection_sensitivity import block_derivatives
+from .erection_residuals import (
+    PatternLayout,
+    ResidualModel,
+    erected_rms,
+    matched,
+    moved,
+    seam_edges,
+)
 from .options import ErectionOptions
 
 __all__ = ["OptimisedPatterns", "OptimumRecord", "optimise_for_erection", "optimised_results"]
@@ -59,19 +63,10 @@ MAX_STEP_STRAIN = 0.02
 #: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
 LSQR_TOLERANCE = 1e-3
 LSQR_LIMIT = 30
-#: Seam edges are matched again after every step until their lengths differ by at most this
-#: fraction of the patterns' size (at most MATCH_STEPS Gauss–Newton steps).
-MATCHED = 1e-13
-MATCH_STEPS = 5
 #: Deviations are measured against the start's, but at least against a force of this strain
 #: times the stiffness and a length of 1e-3 of it times the size; deviations below these are
 #: round-off, nothing is left to gain.
 FLOOR = 1e-8
-#: The weight of each yarn's mean force deviation against the per-cell deviations (the mean
-#: is held to the intended: a uniformly higher tension would lower the shape deviation).
-MEAN_WEIGHT = 30.0
-#: The weight of a node's shape deviation beyond the bound, against the RMS terms.
-BOUND_WEIGHT = 100.0
 
 
 @dataclass(frozen=True)
@@ -141,242 +136,8 @@ class OptimisedPatterns:
         }
 
 
-class _Layout:
-    """Where each pattern coordinate and erected force lives: the variables are the patterns'
-    nodes, panel after panel (``offsets``); per membrane block its panel and panel-local cells."""
-
-    def __init__(self, patterns: list[Pattern], erected: ErectionResult) -> None:
-        counts = [p.mesh.num_points for p in patterns]
-        self.offsets = np.concatenate([[0], np.cumsum(counts)])
-        self.num_variables = 2 * int(self.offsets[-1])
-        self.block_cells = []  # panel-local node ids of each block's cells
-        for p, pattern in enumerate(patterns):
-            for cells in pattern.mesh.cells.values():
-                self.block_cells.append(self.offsets[p] + cells)
-        self.cell_ids = erected.structure.block_cells
-
-    def split(self, vector: np.ndarray) -> list[np.ndarray]:
-        flat = vector.reshape(-1, 2)
-        return [flat[a:b] for a, b in zip(self.offsets[:-1], self.offsets[1:], strict=True)]
-
-
-def _seam_edges(patterns: list[Pattern], erected: ErectionResult, layout: _Layout) -> np.ndarray:
-    """Welded seam edges as pairs of pattern edges ``(k, 2, 2)`` (variable node ids): boundary
-    edges of two panels that weld onto one edge of the structure."""
-    found: dict[tuple[int, int], list[tuple[int, int]]] = {}
-    for p, (pattern, node_map) in enumerate(zip(patterns, erected.node_maps, strict=True)):
-        for a, b in pattern.mesh.boundary_edges():
-            key = (min(node_map[a], node_map[b]), max(node_map[a], node_map[b]))
-            found.setdefault(key, []).append((layout.offsets[p] + a, layout.offsets[p] + b))
-    pairs = [v[:2] for v in found.values() if len(v) >= 2]
-    return np.array(pairs, dtype=int).reshape(-1, 2, 2)
-
-
-def seam_constraints(X: np.ndarray, seams: np.ndarray, num_variables: int):
-    """``c = ℓ_P − ℓ_Q`` per seam edge (its lengths in the two patterns it joins, ``X`` all
-    patterns' nodes ``(N, 2)``) and the Jacobian ``(k, num_variables)``."""
-    if not len(seams):
-        return np.zeros(0), sp.csr_matrix((0, num_variables))
-    ends = X[seams]  # (k, 2 sides, 2 ends, 2)
-    vectors = ends[:, :, 1] - ends[:, :, 0]  # (k, 2, 2)
-    lengths = np.linalg.norm(vectors, axis=-1)  # (k, 2)
-    units = vectors / lengths[..., None]  # d length / d end = ±unit
-    rows, cols, vals = [], [], []
-    for side, sign in ((0, 1.0), (1, -1.0)):
-        for end, direction in ((0, -1.0), (1, 1.0)):
-            for axis in range(2):
-                rows.append(np.arange(len(lengths)))
-                cols.append(2 * seams[:, side, end] + axis)
-                vals.append(sign * direction * units[:, side, axis])
-    jac = sp.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-        shape=(len(lengths), num_variables),
-    )
-    return lengths[:, 0] - lengths[:, 1], jac
-
-
-def _matched(patterns: list[Pattern], seams: np.ndarray, layout: _Layout) -> list[Pattern]:
-    """The patterns moved least (Gauss–Newton, minimum norm) to make every seam edge equally
-    long in its two patterns, to round-off."""
-    if not len(seams):
-        return patterns
-    X = np.concatenate([p.material_coordinates for p in patterns])
-    size = float(np.ptp(X, axis=0).max())
-    for _ in range(MATCH_STEPS):
-        c, C = seam_constraints(X, seams, layout.num_variables)
-        if np.abs(c).max() <= MATCHED * size:
-            break
-        gram = spla.splu((C @ C.T).tocsc())
-        X = X - (C.T @ gram.solve(c)).reshape(-1, 2)
-    return _moved(
-        patterns,
-        layout.split((X - np.concatenate([p.material_coordinates for p in patterns])).ravel()),
-    )
-
-
-class _Model:
-    """The residual vector of ``J`` at one erected state and products with its Jacobian."""
-
-    def __init__(
-        self,
-        patterns: list[Pattern],
-        erected: ErectionResult,
-        layout: _Layout,
-        seams: np.ndarray,
-        scales: tuple[float, float],
-        shape_weight: float,
-        shape_bound: float | None,
-        linear_solver: str | None,
-    ) -> None:
-        self.erected, self.layout, self.seams = erected, layout, seams
-        problem, ctx = erected.problem, erected.context
-        x = erected.erected_points
-        mesh = erected.mesh
-        area = mesh.cell_areas()
-        total = area.sum()
-        force_scale, shape_scale = scales
-        n_cells, n_nodes = mesh.num_cells, mesh.num_points
-        # forces and their derivatives, block by block
-        forces = np.zeros((n_cells, 2))
-        mixed_rows, mixed_cols, mixed_vals = [], [], []
-        fx_rows, fx_cols, fx_vals = [], [], []
-        fX_rows, fX_cols, fX_vals = [], [], []
-        for k, block in enumerate(problem.blocks):
-            d = block_derivatives(problem, k, x)
-            ids = layout.cell_ids[k]
-            forces[ids] = d.forces
-            nen = block.cells.shape[1]
-            xdof = 3 * block.cells[:, :, None] + np.arange(3)  # (m, nen, 3)
-            Xdof = 2 * layout.block_cells[k][:, :, None] + np.arange(2)  # (m, nen, 2)
-            mixed_rows.append(np.broadcast_to(xdof[:, :, :, None, None], d.mixed.shape).ravel())
-            mixed_cols.append(np.broadcast_to(Xdof[:, None, None], d.mixed.shape).ravel())
-            mixed_vals.append(d.mixed.ravel())
-            frow = 2 * ids[:, None] + np.arange(2)  # (m, 2)
-            shape_x = (len(ids), 2, nen, 3)
-            fx_rows.append(np.broadcast_to(frow[:, :, None, None], shape_x).ravel())
-            fx_cols.append(np.broadcast_to(xdof[:, None], shape_x).ravel())
-            fx_vals.append(d.force_by_x.ravel())
-            shape_X = (len(ids), 2, nen, 2)
-            fX_rows.append(np.broadcast_to(frow[:, :, None, None], shape_X).ravel())
-            fX_cols.append(np.broadcast_to(Xdof[:, None], shape_X).ravel())
-            fX_vals.append(d.force_by_X.ravel())
-        nv = layout.num_variables
-        cat = np.concatenate
-        mixed = sp.csr_matrix(
-            (cat(mixed_vals), (cat(mixed_rows), cat(mixed_cols))), shape=(3 * n_nodes, nv)
-        )
-        free = ctx.assembler.free
-        self.mixed = mixed[free]
-        raw_x = sp.csr_matrix(
-            (cat(fx_vals), (cat(fx_rows), cat(fx_cols))), shape=(2 * n_cells, 3 * n_nodes)
-        ).tocsc()[:, np.flatnonzero(free)]
-        raw_X = sp.csr_matrix((cat(fX_vals), (cat(fX_rows), cat(fX_cols))), shape=(2 * n_cells, nv))
-        # per cell and yarn the force deviation, and per yarn its mean (held near zero)
-        force_weight = np.repeat(np.sqrt(area / total), 2) / force_scale
-        mean_rows = sp.csr_matrix(
-            (
-                np.tile(area / total, 2) * np.sqrt(MEAN_WEIGHT) / force_scale,
-                (
-                    np.repeat([0, 1], n_cells),
-                    np.concatenate([2 * np.arange(n_cells) + k for k in (0, 1)]),
-                ),
-            ),
-            shape=(2, 2 * n_cells),
-        )
-        rows_of = sp.vstack([sp.diags(force_weight), mean_rows]).tocsr()
-        self.by_x = rows_of @ raw_x
-        self.by_X = rows_of @ raw_X
-        force_residual = rows_of @ (forces - erected.intended).ravel()
-        # shape: the normal deviation at every node (its derivative the normal itself), and
-        # where it exceeds the bound, the excess
-        normals, node_area = node_normals(mesh)
-        d = erected.normal_deviation
-        rms_weight = np.sqrt(shape_weight * node_area / total) / shape_scale
-        over = np.zeros(n_nodes)
-        if shape_bound is not None:
-            active = np.abs(d) > shape_bound
-            over[active] = np.sqrt(BOUND_WEIGHT * node_area[active] / total) / shape_scale
-        excess = over * (np.abs(d) - (shape_bound or 0.0))
-        weights = np.concatenate([rms_weight, over * np.sign(d)])
-        rows = np.repeat(np.arange(2 * n_nodes), 3)
-        shape_by_x = sp.csr_matrix(
-            (
-                (weights[:, None] * np.vstack([normals, normals])).ravel(),
-                (rows, np.tile(np.arange(3 * n_nodes), 2)),
-            ),
-            shape=(2 * n_nodes, 3 * n_nodes),
-        ).tocsc()[:, np.flatnonzero(free)]
-        shape_residual = np.concatenate([rms_weight * d, excess])
-        self.by_x = sp.vstack([self.by_x, shape_by_x]).tocsr()
-        # seams: the two lengths of every seam edge, equal
-        self.seam_residual, self.seam_by_X = self._seams(patterns)
-        self.residual = np.concatenate([force_residual, shape_residual])
-        self.parts = (
-            float(force_residual @ force_residual),
-            float(shape_residual @ shape_residual),
-        )
-        self.forces = forces
-        self.num_force, self.num_shape = len(force_residual), len(shape_residual)
-        solver = get_solver(linear_solver)
-        # the exact tangent where every cell is taut; the film keeps it definite where cells
-        # wrinkle (their positions then have no determinate derivative across the wrinkles)
-        taut = not erected.fields["state"].any()
-        evaluation = problem.evaluate(x, order=2, stabilised=not taut)
-        solver.factorize(ctx.assembler.matrix(evaluation.hessians))
-        self.solver = solver
-        self.solves = 0
-
-    def _seams(self, patterns: list[Pattern]):
-        """The seam constraints ``c = ℓ_P − ℓ_Q`` (one per seam edge) and their Jacobian."""
-        X = np.concatenate([p.material_coordinates for p in patterns])
-        return seam_constraints(X, self.seams, self.layout.num_variables)
-
-    def _tangent_solve(self, rhs: np.ndarray) -> np.ndarray:
-        self.solves += 1
-        return self.solver.solve(rhs)
-
-    def matvec(self, v: np.ndarray) -> np.ndarray:
-        """``J v``: the residuals' change for a change ``v`` of the patterns."""
-        dx = -self._tangent_solve(self.mixed @ v)
-        forces = self.by_X @ v + self.by_x[: self.num_force] @ dx
-        shape = self.by_x[self.num_force :] @ dx
-        return np.concatenate([forces, shape])
-
-    def rmatvec(self, u: np.ndarray) -> np.ndarray:
-        """``Jᵀ u`` by the adjoint of the erected equilibrium."""
-        nf, ns = self.num_force, self.num_shape
-        adjoint = self._tangent_solve(self.by_x.T @ u[: nf + ns])
-        return self.by_X.T @ u[:nf] - self.mixed.T @ adjoint
-
-    def operator(self) -> spla.LinearOperator:
-        """``J P``: the Jacobian on the steps that keep the seams matched to first order."""
-        shape = (len(self.residual), self.layout.num_variables)
-        if not len(self.seams):
-            return spla.LinearOperator(shape, matvec=self.matvec, rmatvec=self.rmatvec)
-        project = self.projection()
-        return spla.LinearOperator(
-            shape,
-            matvec=lambda v: self.matvec(project(v)),
-            rmatvec=lambda u: project(self.rmatvec(u)),
-        )
-
-    def projection(self):
-        """``P = I − Cᵀ (C Cᵀ)⁻¹ C`` onto the null space of the seam constraints' Jacobian."""
-        if getattr(self, "_projection", None) is None:
-            C = self.seam_by_X.tocsr()
-            gram = spla.splu((C @ C.T).tocsc())
-            self._gram = gram
-            self._projection = lambda v: v - C.T @ gram.solve(C @ v)
-        return self._projection
-
-
 def _erect(patterns, material, thickness, solver, options, start):
     return erect(patterns, material, thickness, solver=solver, options=options, start=start)
-
-
-def _rms(result: ErectionResult) -> float:
-    stats = result.statistics()["stress"]
-    return float(np.hypot(stats["warp"]["rms_deviation"], stats["fill"]["rms_deviation"]))
 
 
 @takes_options(ErectionOptions)
@@ -435,18 +196,18 @@ def optimise_for_erection(
             shape_weight,
             shape_bound,
         )
-    layout = _Layout(patterns, first)
-    seams = _seam_edges(patterns, first, layout)
+    layout = PatternLayout(patterns, first)
+    seams = seam_edges(patterns, first, layout)
     # the start's deviations, but never below a strain of 1e-8 × the stiffness in force and
     # 1e-9 of the size in shape (a pattern at the round-off of its solve is left as it is)
     size = float(np.ptp(first.mesh.points, axis=0).max())
     floors = (FLOOR * material.stiffness_scale * thickness, 1e-3 * FLOOR * size)
-    scales = (max(_rms(first), floors[0]), max(first.deviation()["rms"], floors[1]))
+    scales = (max(erected_rms(first), floors[0]), max(first.deviation()["rms"], floors[1]))
     negligible = ((floors[0] / scales[0]) ** 2, shape_weight * (floors[1] / scales[1]) ** 2)
     bound = None if shape_bound is None else shape_bound * first.deviation()["max"]
 
     def model_of(p, e):
-        return _Model(p, e, layout, seams, scales, shape_weight, bound, solver.linear_solver)
+        return ResidualModel(p, e, layout, seams, scales, shape_weight, bound, solver.linear_solver)
 
     current, erected = patterns, first
     model = model_of(current, erected)
@@ -473,7 +234,7 @@ def optimise_for_erection(
         if predicted < 0.1 * tolerance * objective:
             converged = True  # the model promises no more
             break
-        trial = _matched(_moved(current, layout.split(step)), seams, layout)
+        trial = matched(moved(current, layout.split(step)), seams, layout)
         attempt = _trial_erection(trial, material, thickness, solver, options, erected)
         accepted, decrease = False, 0.0
         if attempt is not None:
@@ -542,7 +303,7 @@ def _trial_erection(trial, material, thickness, solver, options, erected):
     return attempt if attempt.converged else None
 
 
-def _pattern_edges(patterns: list[Pattern], layout: _Layout) -> np.ndarray:
+def _pattern_edges(patterns: list[Pattern], layout: PatternLayout) -> np.ndarray:
     """Every edge of every pattern cell ``(k, 2)`` (variable node ids)."""
     out = []
     for p, pattern in enumerate(patterns):
@@ -562,13 +323,6 @@ def _edge_strain(patterns, step, edges, layout) -> float:
     return float(np.max(np.abs(change) / lengths))
 
 
-def _moved(patterns: list[Pattern], steps: list[np.ndarray]) -> list[Pattern]:
-    return [
-        replace(p, material_coordinates=p.material_coordinates + s)
-        for p, s in zip(patterns, steps, strict=True)
-    ]
-
-
 def _record(iteration, objective, model, erected, patterns, seams, mu, lsqr_its, accepted):
     deviation = erected.deviation()
     mismatch = 0.0
@@ -582,7 +336,7 @@ def _record(iteration, objective, model, erected, patterns, seams, mu, lsqr_its,
         objective,
         model.parts[0],
         model.parts[1],
-        _rms(erected),
+        erected_rms(erected),
         deviation["max"],
         deviation["rms"],
         mismatch,
