@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..materials.fitting import MeasuredCompensationLaw
+from ..materials.compensation_law import MeasuredCompensationLaw
 from ..solver.result import PatternResult
 from .compensation import CompensationReport
 

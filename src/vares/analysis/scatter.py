@@ -17,7 +17,7 @@ import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
 from ..materials.base import MaterialError
-from ..materials.fitting import compensating_law
+from ..materials.compensation_law import compensating_law
 from ..materials.presets import FabricPreset
 from ..solver.api import solve
 from ..solver.result import PatternResult

@@ -18,11 +18,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["BiaxialRecord", "Cycle", "RecordError", "find_cycles", "ratio_label"]
+__all__ = ["BiaxialRecord", "Cycle", "NotInRecord", "RecordError", "find_cycles", "ratio_label"]
 
 
 class RecordError(ValueError):
     """A record cannot be evaluated as asked (no cycles, no hold at the prestress, …)."""
+
+
+class NotInRecord(RecordError):
+    """A record lacks what was asked of it (two load ratios for a fit, a hold at the
+    prestress for compensation values); other records may have it."""
 
 
 @dataclass(frozen=True)

@@ -39,14 +39,20 @@ import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from .base import MaterialError
+
+if TYPE_CHECKING:
+    from .fitting import FabricFit
 
 __all__ = [
     "COMPENSATE_BY",
     "MeasuredCompensation",
     "fabric_toml",
+    "fit_toml",
     "read_test_tables",
     "toml_string",
 ]
@@ -187,3 +193,126 @@ def fabric_toml(
         lines += ["", f"[[{name}.specimens]]"]
         lines += [f"{k} = {_value(v)}" for k, v in specimen.items()]
     return "\n".join(lines) + "\n"
+
+
+def fit_toml(
+    fitted: FabricFit, compensate_by: str | None = None, description: str | None = None
+) -> str:
+    """The fabric file of a fit (:class:`~vares.materials.fitting.FabricFit`): the mean
+    constants, their scatter, the compensation values, how they were fitted and every specimen.
+
+    ``compensate_by``: the pattern's default compensation (``"measured"`` when there are
+    compensation values, else ``"law"``); ``description`` defaults to one naming the
+    specimens and the evaluation."""
+    from .._version import __version__
+
+    choice = compensate_by or ("measured" if fitted.compensation is not None else "law")
+    if choice == "measured" and fitted.compensation is None:
+        raise MaterialError("no compensation records: a pattern can only use the law")
+    mean, std = fitted.constants.mean, fitted.constants.std
+    n = fitted.constants.specimens
+    fit0 = fitted.fits[0]
+    cycle = "last cycle" if fit0.cycle == -1 else f"cycle {fit0.cycle}"
+    ratios = [r.label for r in fit0.residuals]
+    text = description or (
+        f"biaxial fit of {n} specimen(s), load ratios {' '.join(ratios)} ({cycle} of each)"
+    )
+    sources = sorted({r.source for r in (*fitted.fits, *fitted.compensations) if r.source})
+    source = (
+        f"vares {__version__} fabric fit of {', '.join(sources) or 'records'} "
+        f"(MSAJ/M-02 least squares of the strain residual, "
+        f"{'with' if fit0.reciprocal else 'without'} reciprocity"
+        + (", EN 17117-2 compensation values" if fitted.compensation else "")
+        + f"); G12 {fitted.G12:g} kN/m {fitted.G12_source} (not measured by biaxial tests)"
+    )
+    head = {
+        "description": text,
+        "E1": mean["E_w"],
+        "E2": mean["E_f"],
+        "G12": fitted.G12,
+        "nu12": mean["nu_wf"],
+        "source": source,
+        "compensate_by": choice,
+    }
+    tables: dict[str, dict[str, object]] = {
+        "scatter": {
+            "specimens": n,
+            "E1": std["E_w"],
+            "E2": std["E_f"],
+            "nu12": std["nu_wf"],
+            "nu21": std["nu_fw"],
+        }
+    }
+    if fitted.compensation is not None and fitted.prestress is not None:
+        c = fitted.compensation
+        law = fitted.law_compensation() or (math.nan, math.nan)
+        tables["compensation"] = {
+            "prestress": list(fitted.prestress),
+            "warp": c.mean["warp"],
+            "fill": c.mean["fill"],
+            "warp_std": c.std["warp"],
+            "fill_std": c.std["fill"],
+            "specimens": c.specimens,
+            "law_warp": law[0],
+            "law_fill": law[1],
+            "note": "strains (mm/mm) at the prestress after the cycles and holds, from the "
+            "extensometers' zero; erected length = pattern length × (1 + strain)",
+        }
+    tables["fit"] = {
+        "method": "MSAJ/M-02: least squares of the strain residual over the loading "
+        "branches of all load ratios, one strain offset per ratio",
+        "cycle": fit0.cycle,
+        "reciprocal": fit0.reciprocal,
+        "ratios": ratios,
+        "nu21": mean["nu_fw"],
+        "rms_residual": float(np.mean([f.rms for f in fitted.fits])),
+        "nonlinear_rms_residual": float(
+            np.mean([f.nonlinear.get("rms", math.nan) for f in fitted.fits])
+        ),
+        "linear_is_poor": any(f.linear_is_poor for f in fitted.fits),
+        "G12_source": fitted.G12_source,
+    }
+    specimens: list[dict[str, object]] = []
+    for f in fitted.fits:
+        row: dict[str, object] = {
+            "name": f.name,
+            "file": f.source,
+            "E1": f.E_w,
+            "E2": f.E_f,
+            "nu12": f.nu_wf,
+            "nu21": f.nu_fw,
+            "E1_error": f.standard_errors["E_w"],
+            "E2_error": f.standard_errors["E_f"],
+            "nu12_error": f.standard_errors["nu_wf"],
+            "nu21_error": f.standard_errors["nu_fw"],
+            "rms_residual": f.rms,
+            "ratios": [r.label for r in f.residuals],
+            "rms_warp": [r.rms_warp for r in f.residuals],
+            "rms_fill": [r.rms_fill for r in f.residuals],
+        }
+        if f.nonlinear:
+            row |= {
+                "nonlinear_E1": f.nonlinear["E_w"],
+                "nonlinear_E2": f.nonlinear["E_f"],
+                "nonlinear_nu12": f.nonlinear["nu_wf"],
+                "k_w": f.nonlinear["k_w"],
+                "k_f": f.nonlinear["k_f"],
+                "nonlinear_rms_residual": f.nonlinear["rms"],
+            }
+        specimens.append(row)
+    for c in fitted.compensations:
+        specimens.append(
+            {
+                "name": c.name,
+                "file": c.source,
+                "compensation_warp": c.warp,
+                "compensation_fill": c.fill,
+                "read_at": c.time,
+            }
+        )
+    comment = (
+        f"Fabric {fitted.name}: written by vares {__version__} (vares fabric fit).\n"
+        "E1, E2 (E·t, kN/m) and nu12 are the means over the specimens; [scatter] their sample\n"
+        "standard deviations. G12 is not measured by biaxial tests (see source)."
+    )
+    return fabric_toml(fitted.name, head, tables, specimens, comment)

@@ -55,7 +55,7 @@ class FabricPreset:
     def material(self, compensate_by: str | None = None) -> OrthotropicStVenantKirchhoff:
         """The fabric's law; with ``compensate_by="measured"`` (default: the preset's choice)
         the law through the measured compensation values instead
-        (:func:`vares.materials.fitting.compensating_law`: a flat panel under the tested
+        (:func:`vares.materials.compensation_law.compensating_law`: a flat panel under the tested
         prestress is compensated by exactly those strains)."""
         choice = compensate_by or self.compensate_by
         if choice not in COMPENSATE_BY:
@@ -67,7 +67,7 @@ class FabricPreset:
                 f"fabric {self.name!r} has no measured compensation values: compensate by its "
                 "law, or fit it with compensation records ('vares fabric fit --compensation')"
             )
-        from .fitting import compensating_law
+        from .compensation_law import compensating_law
 
         c = self.compensation
         return compensating_law(c.warp, c.fill, c.prestress, self.nu12, self.G12)
