@@ -264,7 +264,7 @@ def test_a_free_pattern_turns_to_where_turning_the_yarns_costs_nothing():
 
 
 def test_a_turning_step_path_leaves_along_the_step_and_turns_rigidly():
-    from vares.solver.newton import _Path
+    from vares.solver.line_search import StepPath
 
     rng = np.random.default_rng(5)
     x = rng.uniform(0.0, 2.0, (12, 2))
@@ -272,11 +272,11 @@ def test_a_turning_step_path_leaves_along_the_step_and_turns_rigidly():
     across = np.column_stack([-(x[:, 1] - 0.5), x[:, 0] - 0.5])
     direction = 0.3 * across + 0.01 * rng.standard_normal((12, 2))
     direction[3] = 0.0
-    path = _Path(x, direction, pivot=3)
+    path = StepPath(x, direction, pivot=3)
     assert path.turn == pytest.approx(0.3, rel=0.05)
     h = 1e-6
     np.testing.assert_allclose((path.at(h) - path.at(-h)) / (2 * h), direction, atol=1e-8)
-    turned = _Path(x, across, pivot=3).at(2.0)  # a pure turn by 2 rad: every distance kept
+    turned = StepPath(x, across, pivot=3).at(2.0)  # a pure turn by 2 rad: every distance kept
     distances = np.linalg.norm(x[:, None] - x[None], axis=-1)
     np.testing.assert_allclose(np.linalg.norm(turned[:, None] - turned[None], axis=-1), distances)
     np.testing.assert_allclose(_Path(x, direction, pivot=None).at(0.7), x + 0.7 * direction)

@@ -23,6 +23,8 @@ import scipy.sparse as sp
 
 from ..materials import InadmissibleState
 from ..mechanics.assembly import Assembler
+from .failure import Failure, describe_cells
+from .line_search import LineSearch
 from .linear import LinearSolver, SingularMatrixError
 from .result import IterationRecord, StepRecord
 from .reuse import ETA_MAX, ReusingSolver, forcing_term
@@ -52,23 +54,6 @@ SQUEEZED_PATTERN = (
 )
 #: ``"full"``: plain Newton; ``"line-search"``: globalised; ``"damped"``: Levenberg–Marquardt.
 METHODS = ("full", "line-search", "damped")
-
-
-class Failure(Exception):
-    """A Newton iteration (or a strategy) did not converge; ``coordinates`` is where it stopped
-    (never inverted)."""
-
-    def __init__(self, reason: str, coordinates: np.ndarray, folding: bool = False) -> None:
-        super().__init__(reason)
-        self.reason = reason
-        self.coordinates = coordinates
-        self.folding = folding  # the energy's minimum lies beyond a fold: no strategy helps
-
-
-def describe_cells(ids: np.ndarray, limit: int = 5) -> str:
-    """``"3 cell(s) (4, 7, 9)"`` for messages."""
-    shown = ", ".join(str(int(i)) for i in ids[:limit])
-    return f"{ids.size} cell(s) ({shown}{', …' if ids.size > limit else ''})"
 
 
 def at_round_off(
@@ -107,7 +92,7 @@ class NewtonContext:
     #: an objective with kinks sets it tighter.
     loosest_forcing: float = ETA_MAX
     #: The node a pattern free to turn (``orientation="free"``) turns about in a line search's
-    #: steps (:class:`_Path`); ``None``: steps are straight lines.
+    #: steps (:class:`~vares.solver.line_search.StepPath`); ``None``: steps are straight lines.
     turning_about: int | None = None
     #: Give up a line-search iteration whose least residual has not halved over this many
     #: iterations (``None``: never), so the next attempt goes on from there: an energy with
@@ -247,31 +232,12 @@ def newton(
         matrix = None if converged else ctx.assembler.matrix(hessians)
         if method == "damped" and matrix is not None:
             state.cap(matrix, residual, initial_residual)
+        record = (strategy, step, tau, iteration, residual, residual / ctx.force_scale)
         ctx.record(
-            IterationRecord(
-                strategy,
-                step,
-                tau,
-                iteration,
-                residual,
-                residual / ctx.force_scale,
-                evaluation.energy,
-                state.c or 0.0,
-                step_length,
-                tangent,
-            )
+            IterationRecord(*record, evaluation.energy, state.c or 0.0, step_length, tangent)
         )
-        if not (np.isfinite(residual) and np.isfinite(evaluation.energy)):
-            raise Failure("non-finite energy or residual", x)
-        if converged:
+        if _ends(ctx, x, evaluation.energy, converged, iteration, method, residuals):
             return x
-        if iteration == ctx.max_iterations:
-            raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
-        if method == "line-search" and _stalled(residuals, ctx.stall_window):
-            raise Failure(
-                f"the residual stalled at {residuals[-1]:.3g} over {ctx.stall_window} iterations",
-                x,
-            )
         eta = forcing_term(
             residuals, ctx.residual_tolerance / ctx.force_scale, ctx.loosest_forcing
         )  # relative residuals: the same ratios
@@ -284,7 +250,7 @@ def newton(
             )
             evaluation = None
         else:
-            search = _LineSearch(
+            search = LineSearch(
                 problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
             )
             # the search owns the tangent now: it lets go of it before evaluating a trial point
@@ -296,6 +262,22 @@ def newton(
                     ctx.squeezed.format(cells=describe_cells(search.bounded_by)), x, folding=True
                 )
     raise AssertionError("unreachable")
+
+
+def _ends(ctx, x, energy, converged, iteration, method, residuals) -> bool:
+    """True when the iteration converged; raises :class:`Failure` where it must end (a value
+    not finite, the iteration limit, a stall)."""
+    if not (np.isfinite(residuals[-1]) and np.isfinite(energy)):
+        raise Failure("non-finite energy or residual", x)
+    if converged:
+        return True
+    if iteration == ctx.max_iterations:
+        raise Failure(f"iteration limit ({ctx.max_iterations}) reached", x)
+    if method == "line-search" and _stalled(residuals, ctx.stall_window):
+        raise Failure(
+            f"the residual stalled at {residuals[-1]:.3g} over {ctx.stall_window} iterations", x
+        )
+    return False
 
 
 def _stalled(residuals: list[float], window: int | None) -> bool:
@@ -346,7 +328,7 @@ def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Dampi
 SQUEEZED_ITERATIONS = 6
 
 
-def _held_back(search: _LineSearch, step_length: float, step_lengths: list[float]) -> bool:
+def _held_back(search: LineSearch, step_length: float, step_lengths: list[float]) -> bool:
     """Whether this step was held back by a fold, and shorter than half the one before."""
     previous = step_lengths[-1] if step_lengths else 1.0
     return (
@@ -355,127 +337,3 @@ def _held_back(search: _LineSearch, step_length: float, step_lengths: list[float
         and step_length < 0.1
         and step_length < 0.5 * previous
     )
-
-
-#: The largest multiple of a projected step's turn that :meth:`_LineSearch._turn_further` tries.
-MAX_TURN_SCALE = 1024.0
-
-
-class _Path:
-    """The points ``x + α d`` of a step, or, for a pattern free to turn about its held node
-    ``pivot``, the step's rigid-rotation part (least squares) made a true rotation: a turn
-    applied linearly stretches the pattern by a factor ``√(1 + φ²)``, an energy that holds a
-    line search back to short steps when the energy turns the pattern far (an anisotropic
-    fabric with ``orientation="free"``: hundreds of iterations). Both paths leave ``x`` along
-    ``d``; ``rest`` is ``d`` less its turn (``det J`` of a turned point is that of the unturned
-    one)."""
-
-    def __init__(self, x: np.ndarray, direction: np.ndarray, pivot: int | None) -> None:
-        self.x, self.rest, self.turn = x, direction, 0.0
-        if pivot is None:  # no turn: a straight step
-            return
-        self.centre = x[pivot]
-        self.arm = x - self.centre
-        across = np.column_stack([-self.arm[:, 1], self.arm[:, 0]])  # d(turned x)/dφ at φ = 0
-        norm = float(np.sum(across * across))
-        if norm > 0:
-            self.turn = float(np.sum(direction * across)) / norm
-            self.rest = direction - self.turn * across
-
-    def at(self, alpha: float, turned: float | None = None) -> np.ndarray:
-        """The point ``α`` along the step, its turn ``turned`` times the step's (default α)."""
-        if self.turn == 0.0:
-            return self.x + alpha * self.rest
-        angle = (alpha if turned is None else turned) * self.turn
-        c, s = np.cos(angle), np.sin(angle)
-        return self.centre + (self.arm + alpha * self.rest) @ np.array([[c, s], [-s, c]])
-
-
-class _LineSearch:
-    """A globalised step: exact tangent first (projected where that gives no descent), bounded
-    to keep every cell admissible, backtracked until the energy falls enough (Armijo).
-
-    The first trial, usually accepted near the solution, is evaluated with its derivatives: the
-    next iteration needs them. The element derivatives at ``x`` and the tangent are dropped once
-    a descent direction is found, before that trial is evaluated (two sets of element blocks
-    would be alive at once; at 1M triangles each is about 0.5 GB); they are computed again in
-    the rare case that the exact tangent's direction finds no decrease and the projected one
-    must be tried.
-    """
-
-    def __init__(
-        self, problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
-    ) -> None:
-        self.problem, self.x, self.ctx, self.eta = problem, x, ctx, eta
-        self.evaluation, self.matrix = evaluation, matrix
-        self.energy = evaluation.energy
-        self.residual_vector, self.projected = residual_vector, projected
-        #: the cells that would fold just beyond the step, when they bounded it
-        self.bounded_by: np.ndarray | None = None
-
-    def step(self):
-        """``(new point, step length, tangent used, evaluation at the new point or None)``."""
-        problem, x, ctx = self.problem, self.x, self.ctx
-        for attempt in ("projected",) if self.projected else ("exact", "projected"):
-            if attempt == "projected" and not self.projected:
-                self.projected = True
-                if self.evaluation is None:
-                    self.evaluation = problem.evaluate(x, order=2)
-                self.matrix = ctx.assembler.matrix(problem.projected_hessians(self.evaluation))
-            try:
-                delta = ctx.step(
-                    self.matrix, -self.residual_vector, self.eta, definite=attempt == "exact"
-                )
-            except SingularMatrixError:
-                continue
-            slope = float(self.residual_vector @ delta)
-            if not slope < 0:
-                continue
-            self.evaluation = self.matrix = None
-            full = np.zeros_like(x)
-            full.ravel()[ctx.assembler.free] = delta
-            path = _Path(x, full, ctx.turning_about)
-            bound = problem.admissible_step(x, path.rest)  # a rotation inverts no cell
-            alpha = min(1.0, 0.9 * bound)
-            self.bounded_by = (
-                problem.inverted_cells(path.at(min(1.0, 1.01 * bound))) if bound < 1 else None
-            )
-            for backtrack in range(40):
-                trial = path.at(alpha)
-                at_trial = None
-                if backtrack > 0:
-                    energy = problem.energy(trial)
-                elif problem.inverted_cells(trial).size:
-                    energy = np.inf
-                else:
-                    try:
-                        at_trial = problem.evaluate(trial, order=2)
-                        energy = at_trial.energy
-                    except InadmissibleState:  # like a fold: shorter steps are tried
-                        energy = np.inf
-                if energy <= self.energy + 1e-4 * alpha * slope + ctx.energy_noise:
-                    tangent = "projected" if self.projected else "exact"
-                    if self.projected and alpha == 1.0 and path.turn != 0.0:
-                        turned = self._turn_further(path, energy)
-                        if turned is not None:
-                            return turned, alpha, "projected, turned", None
-                    return trial, alpha, tangent, at_trial
-                alpha *= 0.5
-        raise Failure("the line search found no decrease of the energy", x)
-
-    def _turn_further(self, path: _Path, energy: float) -> np.ndarray | None:
-        """The step's turn doubled while the energy keeps falling, or ``None`` if doubling it
-        once does not lower it. A projected tangent (the exact one gave no descent: the energy
-        is concave in the pattern's rotation there) is stiffer against turning than the energy
-        is, so its turn falls short: each iteration turns the pattern a little and lowers the
-        energy a little, for dozens of iterations (a non-crimp fabric on a flat hypar whose
-        energy turns it 25°: 283 iterations). The evaluation at the step's own end is not used
-        then: the next iteration evaluates the turned point."""
-        best, scale = None, 2.0
-        while scale <= MAX_TURN_SCALE:
-            trial = path.at(1.0, turned=scale)  # turning inverts no cell the step did not
-            value = self.problem.energy(trial)
-            if not value < energy - self.ctx.energy_noise:
-                break
-            best, energy, scale = trial, value, 2.0 * scale
-        return best
