@@ -279,4 +279,4 @@ def test_a_turning_step_path_leaves_along_the_step_and_turns_rigidly():
     turned = StepPath(x, across, pivot=3).at(2.0)  # a pure turn by 2 rad: every distance kept
     distances = np.linalg.norm(x[:, None] - x[None], axis=-1)
     np.testing.assert_allclose(np.linalg.norm(turned[:, None] - turned[None], axis=-1), distances)
-    np.testing.assert_allclose(_Path(x, direction, pivot=None).at(0.7), x + 0.7 * direction)
+    np.testing.assert_allclose(StepPath(x, direction, pivot=None).at(0.7), x + 0.7 * direction)
