@@ -454,3 +454,22 @@ def test_fabric_file_strings_read_back_as_they_were():
     data = tomllib.loads(text)["f"]
     assert data["source"] == odd and data["fit"]["note"] == odd
     assert data["specimens"][0]["name"] == odd
+
+
+def test_a_file_that_is_no_test_record_says_what_it_is(tmp_path):
+    """A spreadsheet, a binary export or a fabric file among the records (a glob that caught
+    too much) is named as what it is, not as a record without a header line."""
+    shipped = Path(__file__).parent.parent / "examples" / "biaxial" / "pes-batch-42.toml"
+    sheet = tmp_path / "pes-42-A.xlsx"
+    sheet.write_bytes(b"PK\x03\x04" + bytes(range(256)) * 4)
+    raw = tmp_path / "pes-42-A.dat"
+    raw.write_bytes(b"\x00\x01\x02\x03" * 64)
+    for path, message in [
+        (sheet, "is a binary file"),
+        (raw, "is a binary file"),
+        (shipped, "is a TOML file"),
+    ]:
+        with pytest.raises(BiaxialFileError, match=message):
+            read_biaxial(path)
+    result = run("fabric", "fit", sheet, "-o", tmp_path / "f.toml")
+    assert result.exit_code == 2 and "export the record as text (CSV or TSV)" in error_line(result)

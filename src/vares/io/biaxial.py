@@ -144,6 +144,11 @@ def _delimiter(line: str) -> str | None:
 
 def _read_text(path: Path) -> str:
     data = path.read_bytes()
+    if b"\x00" in data[:4096] or data.startswith(b"PK\x03\x04"):  # a zip: .xlsx, .ods
+        raise BiaxialFileError(
+            f"{path} is a binary file (a spreadsheet or a machine's own format), not a test "
+            "record: export the record as text (CSV or TSV)"
+        )
     for encoding in ("utf-8-sig", "cp1252"):
         try:
             return data.decode(encoding)
@@ -194,6 +199,10 @@ def read_biaxial(path: str | Path, *, name: str | None = None) -> BiaxialRecord:
             best[0],
             f"the header names no {' and no '.join(lacking)} column (it has: "
             f"{', '.join(c for c in _COLUMNS if c in best[2])})",
+        )
+    if header_at is None and path.suffix.lower() == ".toml":
+        raise BiaxialFileError(
+            f"{path} is a TOML file (a fabric or job file?), not a test record (CSV or TSV)"
         )
     if header_at is None:
         raise BiaxialFileError(
