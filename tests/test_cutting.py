@@ -288,3 +288,47 @@ def test_coarse_designs_are_cut_into_strips_of_roll_width(name, subdivisions, wi
     chains = [plan.cut.mesh.points[c] for c in plan.cut.lines]
     for first, second in itertools.combinations(chains, 2):
         assert line_distance(first[1:-1], second[1:-1]) > 0.02 * width
+
+
+def test_a_per_cell_prestress_follows_the_cells_the_strips_are_cut_from():
+    """A coarse hypar with quads (refined and cut into strips on its own faces) and a prestress
+    that differs from cell to cell: every strip cell takes the row of the input cell it lies in
+    (found here by brute force: the input quad one of whose triangles, of either diagonal,
+    contains its centroid)."""
+    import vares
+
+    mesh = hypar(size=6.0, rise=0.05, n=6, cell_type="quad")
+    quads = mesh.cells["quad"]
+    rows = np.column_stack([1.0 + np.arange(len(quads)), 0.5 + 0.1 * np.arange(len(quads))])
+    result = vares.cut(
+        mesh,
+        vares.materials.fabric("pes-pvc-type-2").material(),
+        prestress=rows,
+        roll_width=2.0,
+        nest_time=1.0,
+    )
+    assert result.converged and len(result.plan.panels) >= 3
+    corners = mesh.points[quads]
+
+    def containing(point):
+        for k, quad in enumerate(corners):
+            for tri in (quad[[0, 1, 2]], quad[[0, 2, 3]], quad[[0, 1, 3]], quad[[1, 2, 3]]):
+                a, b, c = tri
+                normal = np.cross(b - a, c - a)
+                area = np.linalg.norm(normal)
+                lam = [
+                    np.dot(np.cross(q - p, point - p), normal) / area**2
+                    for p, q in ((b, c), (c, a), (a, b))
+                ]
+                if min(lam) > -1e-9 and abs(np.dot(point - a, normal / area)) < 1e-9:
+                    return k
+        raise AssertionError("no input cell contains the point")
+
+    for panel, solved in zip(result.plan.panels, result.structure.results, strict=True):
+        centres = panel.mesh.points[panel.mesh.cells["triangle"]].mean(axis=1)
+        expected = rows[[containing(c) for c in centres]]
+        np.testing.assert_array_equal(solved.prestress[:, :2], expected)
+    with pytest.raises(ValueError, match="one row per cell of the surface"):
+        vares.cut(
+            mesh, vares.materials.NeoHooke(E=600.0, nu=0.3), prestress=rows[:-1], roll_width=2.0
+        )

@@ -232,3 +232,37 @@ def test_panels_take_their_intended_prestress_per_cell_from_the_input(tmp_path):
     assert again.exit_code == 0, again.stderr
     second = json.loads((out / "erect" / "erect.json").read_text())
     assert second["stress"] == first["stress"]
+
+
+def test_a_cut_takes_its_intended_prestress_per_cell_and_erect_reads_it_again(tmp_path):
+    """`vares cut FILE.vtu --prestress-field …`: the strips are patterned and erected for the
+    rows of the cells they were cut from (the intended forces of erected.vtu span the field's
+    range), and `vares erect DIR` finds the same rows from the saved strips."""
+    mesh = vares.examples.hypar(size=6.0, rise=0.05, n=8)
+    centre = mesh.points[mesh.cells["triangle"]].mean(axis=1)
+    warp = 2.0 + 0.05 * centre[:, 0]
+    source = tmp_path / "roof.vtu"
+    meshio.write(
+        source,
+        meshio.Mesh(
+            mesh.points,
+            [("triangle", mesh.cells["triangle"])],
+            cell_data={"n_warp": [warp], "n_fill": [np.full(len(warp), 1.5)]},
+        ),
+    )
+    out = tmp_path / "cut"
+    flags = ["--fabric", "pes-pvc-type-2", "--prestress-field", "n_warp,n_fill"]
+    result = run(
+        "cut", source, "-o", out, "--roll-width", "2", "--nest-time", "1", *flags, "--erect", "-q"
+    )
+    assert result.exit_code == 0, result.stderr
+    erected = meshio.read(out / "erect" / "erected.vtu")
+    data = {k: v[0] for k, v in erected.cell_data.items()}
+    intended = data["warp_stress"] - data["warp_stress_difference"]
+    assert intended.min() == pytest.approx(warp.min()) and intended.max() == pytest.approx(
+        warp.max()
+    )
+    first = json.loads((out / "erect" / "erect.json").read_text())
+    again = run("erect", out, "-f", "-q")
+    assert again.exit_code == 0, again.stderr
+    assert json.loads((out / "erect" / "erect.json").read_text())["stress"] == first["stress"]

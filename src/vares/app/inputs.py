@@ -12,7 +12,7 @@ import numpy as np
 
 from ..analysis.erection_model import Pattern
 from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, PANEL_NAMES, STRUCTURE_EXAMPLES
-from ..geometry.mesh import MeshError
+from ..geometry.mesh import MeshError, SurfaceMesh
 from ..geometry.repair import RepairReport
 from ..io.meshes import MeshFile, read_mesh, read_mesh_data, read_mesh_file, read_pattern
 from ..io.rhino import read_3dm, unit_system
@@ -201,21 +201,47 @@ def saved_patterns(job: Job) -> list[Pattern]:
     cell_data = [{}] * len(folders)
     if job.prestress.field is not None and job.structure is None:
         cell_data = [read_mesh_data(job.path(job.input.mesh))[1]]
+    elif job.prestress.field is not None and job.cut is not None:  # the cells strips came from
+        cell_data = None
     elif job.prestress.field is not None:  # each panel's rows of the field, as when solved
         cell_data = load_input(job).panel_cell_data
         if len(cell_data) != len(folders):
             raise JobError("per-cell prestress needs the panels' cell data (a mesh file's)")
     patterns = []
+    if cell_data is None:
+        return _saved_strips(job, folders)
     for folder, data in zip(folders, cell_data, strict=True):
-        summary = _read_json(folder / "summary.json")
-        name = summary.get("name") or folder.name
-        if not summary.get("converged"):
-            raise JobError(f"{name}: the pattern did not converge ({summary.get('reason')})")
-        mesh = read_mesh(folder / "surface.vtu")
-        coordinates = read_pattern(folder / "pattern.vtu", mesh)
-        fibres = Fibres(*(np.asarray(summary["fibres"][k], dtype=float) for k in ("warp", "fill")))
-        prestress = job.prestress.value(data)
-        patterns.append(Pattern(mesh, coordinates, fibres, prestress, name))
+        name, mesh, coordinates, fibres = _saved_panel(folder)
+        patterns.append(Pattern(mesh, coordinates, fibres, job.prestress.value(data), name))
+    return patterns
+
+
+def _saved_panel(folder: Path) -> tuple[str, SurfaceMesh, np.ndarray, Fibres]:
+    """A panel's name, surface, pattern and fibres as a run wrote them into ``folder``."""
+    summary = _read_json(folder / "summary.json")
+    name = summary.get("name") or folder.name
+    if not summary.get("converged"):
+        raise JobError(f"{name}: the pattern did not converge ({summary.get('reason')})")
+    mesh = read_mesh(folder / "surface.vtu")
+    coordinates = read_pattern(folder / "pattern.vtu", mesh)
+    fibres = Fibres(*(np.asarray(summary["fibres"][k], dtype=float) for k in ("warp", "fill")))
+    return name, mesh, coordinates, fibres
+
+
+def _saved_strips(job: Job, folders: list[Path]) -> list[Pattern]:
+    """The saved patterns of a cut whose prestress is per cell of its surface: each strip's
+    cells take the rows of the surface's cells they were cut from, as when solved."""
+    from ..geometry.surface_lines import triangulated
+    from ..structures.cutting import input_cells
+
+    source = load_input(job)
+    surface = source.panels[0].mesh
+    rows = np.asarray(job.prestress.value(source.cell_data), dtype=float)
+    patterns = []
+    for folder in folders:
+        name, mesh, coordinates, fibres = _saved_panel(folder)
+        (ids,) = input_cells(surface, triangulated(surface), [Panel(name, mesh)])
+        patterns.append(Pattern(mesh, coordinates, fibres, rows[ids], name))
     return patterns
 
 

@@ -400,8 +400,6 @@ def _solve_cut(job, source: Input, material, options, callback) -> JobOutcome:
     """Cut the surface into strips, pattern them, nest them (:func:`vares.structures.cut`)."""
     from ..structures.cutting import cut
 
-    if job.prestress.field is not None:
-        raise JobError("per-cell prestress is not available for cut jobs yet")
     lines = None
     if job.cut.seams == "curves":
         from ..io.curves import read_curves
@@ -413,7 +411,7 @@ def _solve_cut(job, source: Input, material, options, callback) -> JobOutcome:
         source.panels[0].mesh,
         material,
         job.material.thickness,
-        prestress=job.prestress.value({}),
+        prestress=job.prestress.value(source.cell_data),
         lines=lines,
         allowance=job.output.allowance,
         units=source.units,

@@ -29,9 +29,9 @@ from .layout import CELLS_ACROSS, StripPlan, plan_strips, strips_along_lines
 from .matching import StructureResult, solve_structure
 from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
-from .panels import width_across_warp
+from .panels import Panel, width_across_warp
 
-__all__ = ["CutResult", "PieceOutline", "SeamLine", "cut", "with_patterns"]
+__all__ = ["CutResult", "PieceOutline", "SeamLine", "cut", "input_cells", "with_patterns"]
 
 #: Plans tried at most (each narrower than the last) until every pattern fits the roll.
 MAX_ROUNDS = 3
@@ -148,6 +148,8 @@ def cut(
 
     ``roll_width`` (an option, below) is in the mesh's ``units``; ``allowance`` (the seam
     allowance) and the edge allowances are in ``dxf_units``, as on the cutter's drawing.
+    ``prestress`` is uniform or one row per cell of ``mesh`` (the membrane forces of a
+    form-finding run): each strip's cells take the rows of the cells they were cut from.
     ``lines`` are the user's cutting lines (polylines ``(k, 3)`` near the surface), given
     with ``seams = "curves"`` (a job names a file of them instead: option ``curves``). The
     warp runs along each strip unless ``warp_direction`` is given.
@@ -164,6 +166,12 @@ def cut(
     usable = usable_width(cutting.roll_width)
     allowances = _allowances(cutting, allowance, scale)
     surface = triangulated(mesh)
+    per_cell = prestress is not None and np.ndim(prestress) == 2
+    if per_cell and len(prestress) != mesh.num_cells:
+        raise ValueError(
+            f"a per-cell prestress needs one row per cell of the surface ({mesh.num_cells}); "
+            f"got {len(prestress)}"
+        )
     target, rounds = usable, []
     for _ in range(MAX_ROUNDS):
         plan = _plan(surface, target, cutting, allowances, options, lines)
@@ -171,11 +179,16 @@ def cut(
             {} if options.warp_direction is not None else {"warp_direction": tuple(w)}
             for w in plan.warps
         ]
+        panel_prestress = None
+        if per_cell:
+            rows = np.asarray(prestress, dtype=float)
+            panel_prestress = [rows[k] for k in input_cells(mesh, surface, plan.panels)]
         result = solve_structure(
             plan.panels,
             material,
             thickness,
-            prestress=prestress,
+            prestress=None if per_cell else prestress,
+            panel_prestress=panel_prestress,
             panel_settings=own,
             options=options,
             structure=structure,
@@ -208,6 +221,36 @@ def cut(
         time.perf_counter() - started,
         float(min_angles(surface.points, surface.cells["triangle"]).min()),
     )
+
+
+def input_cells(
+    mesh: SurfaceMesh, surface: SurfaceMesh, panels: Sequence[Panel]
+) -> list[np.ndarray]:
+    """Per panel, the cell of the input ``mesh`` (global cell order) each of its cells lies in:
+    the surface is refined and cut on its own faces, so every panel cell lies in one of the
+    triangles of ``surface`` (``mesh`` with its quads split, :func:`triangulated`)."""
+    from ..geometry.surface_points import FaceLocator
+
+    offsets, start = {}, 0
+    for cell_type, cells in mesh.cells.items():
+        offsets[cell_type], start = start, start + len(cells)
+    n_tri = len(mesh.cells.get("triangle", ()))
+    n_quad = len(mesh.cells.get("quad", ()))
+    # the triangulated surface: the triangles, then every quad's first half, then its second
+    face = np.arange(n_tri + 2 * n_quad)
+    quad = np.where(face < n_tri + n_quad, face - n_tri, face - n_tri - n_quad)
+    origin = np.where(
+        face < n_tri, offsets.get("triangle", 0) + face, offsets.get("quad", 0) + quad
+    )
+    locator = FaceLocator(surface)
+    out = []
+    for panel in panels:
+        centres = np.concatenate(
+            [panel.mesh.points[c].mean(axis=1) for c in panel.mesh.cells.values()]
+        )
+        faces, _, _ = locator.locate(centres)
+        out.append(origin[faces])
+    return out
 
 
 def _allowances(cutting: CutOptions, allowance: float, scale: float) -> dict[str, float]:
