@@ -11,6 +11,7 @@ from .erect import erect
 from .evaluate import evaluate
 from .fabric import fabric_app
 from .fabrics import fabrics
+from .laminate import laminate
 from .panels import panels
 from .pattern import example, pattern
 from .run import run
@@ -25,6 +26,7 @@ app = typer.Typer(
 )
 for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch, drape):
     app.command()(command)
+app.command()(laminate)
 app.add_typer(fabric_app, name="fabric")
 
 

@@ -1,0 +1,83 @@
+"""``vares laminate``: drape every ply of a laminate job and check every pair of plies."""
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import console, guarded
+
+__all__ = ["laminate"]
+
+
+def laminate(
+    job_file: Annotated[Path, typer.Argument(metavar="JOB", help="Laminate job file (TOML).")],
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="Write the outputs here instead of the job's folder."),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers",
+            min=1,
+            help="Processes that drape the plies at once (default: the job's [laminate] "
+            "workers, else one per core).",
+        ),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", "-f", help="Overwrite output files.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Show no progress.")] = False,
+) -> None:
+    """Drape every ply of a laminate (mechanical pattern and kinematic net) and check every pair.
+
+    Writes laminate.json, laminate.md (the pair matrices), laminate.vtu (the draped warp and fill
+    per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply), orientations.csv and
+    patterns/<drape>.vtu into the output directory. Exit status 1 when a ply did not converge.
+    """
+
+    def body() -> None:
+        from ..laminate_job import load_laminate_job
+        from ..laminate_outputs import laminate_files, run_laminate
+
+        job = load_laminate_job(job_file)
+        if output is not None:
+            job = job.with_output(output)
+
+        def progress(drape) -> None:
+            if not quiet:
+                state = "converged" if drape.converged else f"NOT converged: {drape.pattern.reason}"
+                console.print(
+                    f"  {drape.label} ({', '.join(drape.plies)}): {state}, "
+                    f"{drape.pattern.iterations} iterations, {drape.seconds:.2f} s"
+                )
+
+        result = run_laminate(job, force=force, workers=workers, callback=progress)
+        if not quiet:
+            _show(result)
+            for path in laminate_files(job, result.labels):
+                console.print(f"  wrote {path}")
+        if not result.converged:
+            raise typer.Exit(1)
+
+    guarded(body)
+
+
+def _show(result) -> None:
+    from rich.table import Table
+
+    labels = result.labels
+    for value, title in (
+        ("warp_compressed_fraction", "area with compressed warp [%]"),
+        ("largest_compression", "largest yarn compression [%]"),
+        ("mean_deviation", "mean fibre-angle deviation [°]"),
+    ):
+        matrix = result.pair_matrix(value)
+        table = Table("blank \\ ply", *labels, title=f"ply-stack check: {title}")
+        for label, row in zip(labels, matrix, strict=True):
+            scale = 1.0 if value == "mean_deviation" else 100.0
+            table.add_row(label, *("–" if v != v else f"{scale * v:.2f}" for v in row))
+        console.print(table)
+    console.print(
+        f"{len(result.laminate.plies)} plies, {len(result.drapes)} distinct drapes in "
+        f"{result.seconds:.2f} s on {result.workers} worker(s)"
+    )

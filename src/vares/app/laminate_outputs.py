@@ -1,0 +1,222 @@
+"""Running a laminate job and writing what it found (``vares laminate``).
+
+Into the job's output folder (replaced as a whole when the run succeeds, see
+:mod:`vares.app.staging`):
+
+- ``laminate.json``: every ply, every distinct drape (convergence, shear, the kinematic net beside
+  the pattern) and the pair matrices of the ply-stack check;
+- ``laminate.md``: the same as tables (the ply stack, the drapes, the pair matrices);
+- ``laminate.vtu``: the mould with, per ply, the cell vectors ``<ply>_warp`` and ``<ply>_fill``
+  (unit, draped by the mechanical pattern), the cell field ``<ply>_shear_angle`` (degrees) and
+  the kinematic net's ``<ply>_kinematic_warp``, ``<ply>_kinematic_fill`` and
+  ``<ply>_kinematic_shear_angle``; NaN outside a ply's region;
+- ``orientations.inp``: the Abaqus orientation table, one ``*ORIENTATION`` per ply
+  (:mod:`vares.io.orientations`); ``orientations.csv``: the same directions with element ids and
+  the shear angle;
+- ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..io.files import write_json, write_text
+from ..io.meshes import write_surface
+from ..io.orientations import PlyOrientations, write_abaqus_orientations, write_orientation_csv
+from ..structures.laminate import PAIR_VALUES, LaminateResult, PlyDrapeResult, drape_laminate
+from .inputs import load_input, safe_name
+from .laminate_job import LaminateJob
+from .staging import OutputFolder
+
+__all__ = [
+    "file_label",
+    "laminate_files",
+    "laminate_markdown",
+    "orientation_tables",
+    "run_laminate",
+    "write_laminate",
+]
+
+#: What each pair matrix shows, and how its values are printed.
+PAIR_TITLES = {
+    "compressed_area_fraction": ("area with a compressed yarn", "%"),
+    "warp_compressed_fraction": ("area with compressed warp", "%"),
+    "fill_compressed_fraction": ("area with compressed fill", "%"),
+    "largest_compression": ("largest yarn compression (strain)", "%"),
+    "min_yarn_stress": ("most compressive yarn stress", "stress"),
+    "mean_deviation": ("mean deviation from the ply's own drape", "°"),
+    "max_deviation": ("largest deviation from the ply's own drape", "°"),
+}
+
+
+def laminate_files(job: LaminateJob, labels: list[str] | None = None) -> list[Path]:
+    """The files a run writes (``labels``: the distinct drapes' labels, if known)."""
+    directory = job.directory
+    names = ["laminate.json", "laminate.md", "laminate.vtu", "orientations.inp", "orientations.csv"]
+    paths = [directory / n for n in names]
+    for label in labels or []:
+        paths.append(directory / "patterns" / f"{file_label(label)}.vtu")
+    return paths
+
+
+def file_label(label: str) -> str:
+    """A drape's label as a file name: ``"-45°"`` → ``"drape_-45deg"``."""
+    return safe_name("drape_" + label.replace("°", "deg").replace(" ", ""))
+
+
+def orientation_tables(result: LaminateResult) -> list[PlyOrientations]:
+    """Per ply (bottom first) its elements (labels from 1), draped warp, fill and shear."""
+    tables = []
+    for ply in result.laminate.plies:
+        drape = result.drape(ply.name)
+        cells = drape.cells
+        default_fill = np.cross(drape.normal, drape.warp_direction)
+        tables.append(
+            PlyOrientations(
+                ply.name,
+                cells + 1,
+                drape.warp[cells],
+                drape.fill[cells],
+                drape.shear_angle[cells],
+                drape.warp_direction,
+                default_fill / np.linalg.norm(default_fill),
+            )
+        )
+    return tables
+
+
+def _cell_vectors(result: LaminateResult) -> dict[str, np.ndarray]:
+    fields: dict[str, np.ndarray] = {}
+    for ply in result.laminate.plies:
+        drape = result.drape(ply.name)
+        name = ply.name
+        fields[f"{name}_warp"] = drape.warp
+        fields[f"{name}_fill"] = drape.fill
+        fields[f"{name}_shear_angle"] = drape.shear_angle
+        fields[f"{name}_kinematic_warp"] = drape.kinematic_warp
+        fields[f"{name}_kinematic_fill"] = drape.kinematic_fill
+        fields[f"{name}_kinematic_shear_angle"] = drape.kinematic_shear_angle
+    return fields
+
+
+def _percent(value: float) -> str:
+    return "–" if not np.isfinite(value) else f"{100 * value:.1f}"
+
+
+def _matrix_lines(result: LaminateResult, value: str) -> list[str]:
+    title, unit = PAIR_TITLES[value]
+    labels = result.labels
+    matrix = result.pair_matrix(value)
+    lines = [
+        f"**{title}** ({unit}; row: the blank of, column: used for)",
+        "",
+        "| blank \\ ply | " + " | ".join(labels) + " |",
+        "|---" * (len(labels) + 1) + "|",
+    ]
+    for label, row in zip(labels, matrix, strict=True):
+        if unit == "%":
+            cells = [_percent(v) for v in row]
+        else:
+            cells = ["–" if not np.isfinite(v) else f"{v:.3g}" for v in row]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return [*lines, ""]
+
+
+def laminate_markdown(result: LaminateResult) -> str:
+    """The run as Markdown tables: the stack, the drapes and the pair matrices."""
+    options = result.laminate.options
+    lines = [
+        "# Laminate",
+        "",
+        f"{len(result.laminate.plies)} plies, {len(result.drapes)} distinct drapes, "
+        f"{result.seconds:.2f} s on {result.workers} worker(s); reference direction "
+        f"{tuple(options.reference)}; a yarn is compressed when shortened by more than "
+        f"{100 * options.compression_strain:g} %.",
+        "",
+        "| ply | orientation | drape | region | drop-off |",
+        "|---|---|---|---|---|",
+    ]
+    for ply in result.laminate.plies:
+        o = ply.options
+        region = (
+            "–"
+            if o.region is None
+            else f"{o.region}" + ("" if o.region_value is None else f" = {o.region_value:g}")
+        )
+        drop = "–" if o.drop_off is None else str(o.drop_off)
+        label = result.ply_drape[o.name]
+        lines.append(f"| {o.name} | {o.orientation:g}° | {label} | {region} | {drop} |")
+    lines += [
+        "",
+        "| drape | converged | iterations | energy | largest shear | kinematic largest shear "
+        "| mean difference | seconds |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for drape in result.drapes:
+        data = drape.summary()
+        kinematic = data.get("kinematic_drape", {}).get("against_pattern", {})
+        k_max = kinematic.get("max_kinematic_shear", np.nan)
+        k_diff = kinematic.get("mean_abs_difference", np.nan)
+        lines.append(
+            f"| {drape.label} | {'yes' if drape.converged else 'no'} | {data['iterations']} | "
+            f"{data['energy']:.6g} | {data['max_shear']:.2f}° | {k_max:.2f}° | {k_diff:.2f}° | "
+            f"{drape.seconds:.2f} |"
+        )
+    lines += ["", "## Ply-stack check", ""]
+    for value in PAIR_VALUES:
+        lines += _matrix_lines(result, value)
+    return "\n".join(lines)
+
+
+def write_laminate(folder: OutputFolder, job: LaminateJob, result: LaminateResult) -> None:
+    """Write every file of :func:`laminate_files` into the staged folder."""
+    paths = laminate_files(job, result.labels)
+    staged = {p.name: folder.staged(p) for p in paths[:5]}
+    write_json(staged["laminate.json"], result.summary())
+    write_text(staged["laminate.md"], laminate_markdown(result))
+    write_surface(staged["laminate.vtu"], result.mesh, None, _cell_vectors(result))
+    tables = orientation_tables(result)
+    write_abaqus_orientations(staged["orientations.inp"], tables)
+    write_orientation_csv(staged["orientations.csv"], tables)
+    for drape, path in zip(result.drapes, paths[5:], strict=True):
+        target = folder.staged(path)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        write_surface(target, drape.mesh, drape.pattern.material_coordinates, drape.pattern.fields)
+
+
+def run_laminate(
+    job: LaminateJob,
+    *,
+    force: bool = False,
+    workers: int | None = None,
+    callback: Callable[[PlyDrapeResult], None] | None = None,
+) -> LaminateResult:
+    """Drape the job's laminate and write its files (module docs); the result."""
+    loaded = load_input(job.job)
+    mesh = loaded.panels[0].mesh
+    inputs = [job.job.path(p) for p in job.job.input.paths]
+    if job.job.location is not None:
+        inputs.append(job.job.location)
+    folder = OutputFolder(
+        job.directory, laminate_files(job), force=force, inputs=inputs, command="laminate"
+    )
+    folder.check()
+    options = job.laminate if workers is None else job.laminate.replace(workers=workers)
+    result = drape_laminate(
+        mesh,
+        job.build_plies(),
+        options,
+        cell_data=loaded.cell_data,
+        solve_settings=job.job.solve.to_dict(),
+        callback=callback,
+    )
+    folder.start()
+    try:
+        write_laminate(folder, job, result)
+        folder.commit()
+    finally:
+        folder.discard()
+    return result

@@ -1,0 +1,580 @@
+"""A laminate: a stack of plies on one mould, each draped, every pair checked (DESIGN.md §8).
+
+A ply is a fabric laid from a seed point with its warp at an ``orientation`` angle from the
+laminate's reference direction: the reference projected onto the mould's tangent plane at the seed,
+turned by the angle counter-clockwise about the surface normal there. That 3D direction is the
+``warp_direction`` of the ply's mechanical drape (:func:`vares.solve`: the erected warp's
+area-weighted mean angle from it is zero) and the warp of its kinematic net at the seed
+(:func:`vares.analysis.drape.drape_ply`).
+
+Plies that differ only in name and drop-off (the two halves of a symmetric stack) share one
+drape. The **ply-stack check** (the seed's Fig. 11) erects the blank of drape A with the yarns of
+drape B: a blank cut for A from a roll turned for B, i.e. B's yarns at ``θ_B − θ_A`` in A's
+pattern frame (where A's warp runs along +x). It reports per pair the area whose warp or fill is
+compressed (shortened by more than ``compression_strain``), the largest yarn compression and the
+deviation of the erected yarns from B's own drape.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from multiprocessing import get_context
+from typing import Any
+
+import numpy as np
+
+from ..analysis.drape import PlyDrape, drape_ply
+from ..analysis.evaluate import evaluate
+from ..geometry.elements import ELEMENTS, inverse
+from ..geometry.mesh import SurfaceMesh
+from ..materials import Hyperelastic
+from ..options import OptionsError, split_settings, takes_options
+from ..solver.api import solve
+from ..solver.result import PatternResult
+from .laminate_options import LaminateOptions, PlyOptions
+
+__all__ = [
+    "Laminate",
+    "LaminateOptions",
+    "LaminateResult",
+    "PairCheck",
+    "Ply",
+    "PlyDrapeResult",
+    "PlyOptions",
+    "drape_laminate",
+    "draped_yarns",
+    "ply_warp",
+]
+
+
+@dataclass(frozen=True)
+class Ply:
+    """A ply: its :class:`PlyOptions` and its material (a hyperelastic law, thickness 1)."""
+
+    options: PlyOptions
+    material: Hyperelastic
+
+    @property
+    def name(self) -> str:
+        return self.options.name
+
+
+@dataclass(frozen=True)
+class Laminate:
+    """A stack of plies, bottom (mould side) first, and the options they share."""
+
+    plies: tuple[Ply, ...]
+    options: LaminateOptions = field(default_factory=LaminateOptions)
+
+    def __post_init__(self) -> None:
+        if not self.plies:
+            raise OptionsError(None, "a laminate needs at least one ply")
+        names = [p.name for p in self.plies]
+        repeated = sorted({n for n in names if names.count(n) > 1})
+        if repeated:
+            raise OptionsError("name", f"must be unique among the plies; repeated: {repeated}")
+        orders = [p.options.drop_off for p in self.plies if p.options.drop_off is not None]
+        if len(set(orders)) != len(orders):
+            raise OptionsError("drop_off", f"must differ from ply to ply; got {orders}")
+
+
+def ply_warp(
+    mesh: SurfaceMesh, seed: np.ndarray, reference: np.ndarray, orientation: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The warp ``(3,)`` (unit) of a ply at ``seed`` ``(3,)`` and the mould's unit normal there
+    ``(3,)``: ``reference`` ``(3,)`` projected onto the tangent plane at the seed, turned by
+    ``orientation`` degrees counter-clockwise about the normal. The normal is the area-weighted
+    normal of the cells round the mould node nearest the seed."""
+    seed = np.asarray(seed, dtype=float)
+    node = int(np.argmin(np.linalg.norm(mesh.points - seed, axis=1)))
+    vectors = mesh.area_vectors()
+    around = np.concatenate([np.any(c == node, axis=1) for c in mesh.cells.values()])
+    normal = vectors[around].sum(axis=0)
+    normal /= np.linalg.norm(normal)
+    reference = np.asarray(reference, dtype=float)
+    tangent = reference - (reference @ normal) * normal
+    if np.linalg.norm(tangent) < 1e-6 * np.linalg.norm(reference):
+        raise OptionsError(
+            "reference", "is normal to the mould at the seed: it gives no direction there"
+        )
+    tangent /= np.linalg.norm(tangent)
+    angle = np.radians(orientation)
+    warp = np.cos(angle) * tangent + np.sin(angle) * np.cross(normal, tangent)
+    return warp / np.linalg.norm(warp), normal
+
+
+def draped_yarns(
+    mesh: SurfaceMesh, coordinates: np.ndarray, warp: np.ndarray, fill: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The erected warp and fill ``(m, 3)`` per cell (unit, global cell order) of the pattern
+    ``coordinates`` ``(n, 2)`` with the yarn directions ``warp``, ``fill`` ``(2,)`` of the pattern
+    plane: ``F Φ`` averaged over the cell's quadrature points (pattern-area weights), normalised."""
+    out = []
+    for phi in (np.asarray(warp, dtype=float), np.asarray(fill, dtype=float)):
+        blocks = []
+        for cell_type, cells in mesh.cells.items():
+            element = ELEMENTS[cell_type]
+            j = element.jacobians(mesh.points, cells)
+            J = element.jacobians(coordinates, cells)
+            erected = np.einsum("mqik,mqkl,l->mqi", j, inverse(J), phi)
+            weight = np.linalg.det(J) * element.quadrature_weights
+            mean = np.einsum("mq,mqi->mi", weight, erected)
+            blocks.append(mean / np.linalg.norm(mean, axis=1)[:, None])
+        out.append(np.vstack(blocks))
+    return out[0], out[1]
+
+
+@dataclass
+class PlyDrapeResult:
+    """One distinct drape of a laminate (the plies ``plies`` share it).
+
+    ``cells`` ``(k,)``: the mould cells it covers (global cell order); ``mesh`` the ply's mesh
+    (those cells; the whole mould when the ply has no region) and ``nodes`` ``(n_ply,)`` its nodes'
+    indices on the mould. ``seed``, ``warp_direction``, ``normal`` ``(3,)``: where it is laid and
+    the warp there. ``pattern``: the mechanical drape (:func:`vares.solve`, warp along +x);
+    ``kinematic``: the pin-jointed net beside it (``None`` when not asked for or failed, with
+    ``kinematic_error``). Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``,
+    ``fill`` (unit erected yarns of the pattern), ``shear_angle`` (degrees, the decrease of the
+    angle between the yarns) and the kinematic ``kinematic_warp``, ``kinematic_fill``,
+    ``kinematic_shear_angle``.
+    """
+
+    label: str
+    plies: list[str]
+    orientation: float
+    cells: np.ndarray
+    nodes: np.ndarray
+    mesh: SurfaceMesh
+    seed: np.ndarray
+    warp_direction: np.ndarray
+    normal: np.ndarray
+    material: Hyperelastic
+    pattern: PatternResult
+    warp: np.ndarray
+    fill: np.ndarray
+    shear_angle: np.ndarray
+    kinematic: PlyDrape | None
+    kinematic_error: str | None
+    kinematic_warp: np.ndarray
+    kinematic_fill: np.ndarray
+    kinematic_shear_angle: np.ndarray
+    seconds: float
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.pattern.converged)
+
+    def summary(self) -> dict[str, Any]:
+        """The numbers for a summary file."""
+        area = self.mesh.cell_areas()
+        shear = self.shear_angle[self.cells]
+        data: dict[str, Any] = {
+            "label": self.label,
+            "plies": self.plies,
+            "orientation": self.orientation,
+            "seed": self.seed,
+            "warp_direction": self.warp_direction,
+            "cells": len(self.cells),
+            "area": float(area.sum()),
+            "converged": self.converged,
+            "reason": self.pattern.reason,
+            "iterations": self.pattern.iterations,
+            "energy": self.pattern.energy,
+            "warp_deviation": self.pattern.warp_deviation,
+            "seconds": self.seconds,
+            "max_shear": float(np.nanmax(np.abs(shear))),
+            "mean_abs_shear": float(area @ np.abs(shear) / area.sum()),
+        }
+        if self.kinematic is not None:
+            data["kinematic_drape"] = self.kinematic.summary()
+            data["kinematic_drape"]["against_pattern"] = self.kinematic.comparison(shear, area)
+        elif self.kinematic_error is not None:
+            data["kinematic_drape"] = {"error": self.kinematic_error}
+        return data
+
+
+@dataclass(frozen=True)
+class PairCheck:
+    """The blank of drape ``blank`` erected with the yarns of drape ``ply`` (their labels).
+
+    ``compressed_area_fraction``: the share of the 3D area whose warp or fill is shortened by
+    more than the threshold; ``warp_compressed_fraction``, ``fill_compressed_fraction``: of each
+    yarn alone; ``largest_compression``: the largest yarn shortening (strain, 1 − stretch; 0
+    when none is shorter); ``min_yarn_stress``: the most compressive Cauchy yarn stress;
+    ``mean_deviation``, ``max_deviation``: the angle (degrees, area-weighted mean and largest)
+    between the erected warp and the warp of ``ply``'s own drape; ``energy``: of the erection.
+    ``checked`` is False (and the numbers NaN) when the two cover different cells.
+    """
+
+    blank: str
+    ply: str
+    checked: bool
+    compressed_area_fraction: float = np.nan
+    warp_compressed_fraction: float = np.nan
+    fill_compressed_fraction: float = np.nan
+    largest_compression: float = np.nan
+    min_yarn_stress: float = np.nan
+    mean_deviation: float = np.nan
+    max_deviation: float = np.nan
+    energy: float = np.nan
+
+    def summary(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+#: The numbers of a :class:`PairCheck` that the pair matrices show.
+PAIR_VALUES = (
+    "compressed_area_fraction",
+    "warp_compressed_fraction",
+    "fill_compressed_fraction",
+    "largest_compression",
+    "min_yarn_stress",
+    "mean_deviation",
+    "max_deviation",
+)
+
+
+@dataclass
+class LaminateResult:
+    """A draped laminate: ``drapes`` (one per distinct ply, in the order of their first ply),
+    ``ply_drape`` (ply name → the label of its drape), ``pairs`` (every ordered pair of drapes,
+    ``(blank, ply)`` → :class:`PairCheck`), the laminate and the seconds taken."""
+
+    mesh: SurfaceMesh
+    laminate: Laminate
+    drapes: list[PlyDrapeResult]
+    ply_drape: dict[str, str]
+    pairs: dict[tuple[str, str], PairCheck]
+    seconds: float
+    workers: int
+
+    @property
+    def converged(self) -> bool:
+        return all(d.converged for d in self.drapes)
+
+    @property
+    def labels(self) -> list[str]:
+        return [d.label for d in self.drapes]
+
+    def drape(self, ply: str) -> PlyDrapeResult:
+        """The drape of the ply named ``ply``."""
+        label = self.ply_drape[ply]
+        return next(d for d in self.drapes if d.label == label)
+
+    def pair_matrix(self, value: str) -> np.ndarray:
+        """``(k, k)`` matrix of one of :data:`PAIR_VALUES`: row = the blank's drape, column =
+        the ply it is used for (both in the order of :attr:`labels`)."""
+        if value not in PAIR_VALUES:
+            raise ValueError(f"value must be one of {', '.join(PAIR_VALUES)}; got {value!r}")
+        labels = self.labels
+        return np.array([[getattr(self.pairs[a, b], value) for b in labels] for a in labels])
+
+    def summary(self) -> dict[str, Any]:
+        """The numbers for ``laminate.json``."""
+        plies = []
+        for ply in self.laminate.plies:
+            o = ply.options
+            plies.append(
+                {
+                    "name": o.name,
+                    "orientation": o.orientation,
+                    "drape": self.ply_drape[o.name],
+                    "drop_off": o.drop_off,
+                    "region": o.region,
+                    "region_value": o.region_value,
+                    "material": type(ply.material).__name__,
+                }
+            )
+        return {
+            "converged": self.converged,
+            "seconds": self.seconds,
+            "workers": self.workers,
+            "reference": list(self.laminate.options.reference),
+            "compression_strain": self.laminate.options.compression_strain,
+            "plies": plies,
+            "drapes": [d.summary() for d in self.drapes],
+            "pair_labels": self.labels,
+            "pairs": {v: self.pair_matrix(v).tolist() for v in PAIR_VALUES},
+        }
+
+
+def _region_cells(ply: PlyOptions, cell_data: Mapping[str, np.ndarray], num_cells: int):
+    if ply.region is None:
+        return np.arange(num_cells)
+    if ply.region not in cell_data:
+        known = ", ".join(cell_data) or "none"
+        raise OptionsError(
+            "region", f"of ply {ply.name!r} names no cell field of the mould (it has: {known})"
+        )
+    values = np.asarray(cell_data[ply.region], dtype=float).reshape(num_cells, -1)[:, 0]
+    chosen = values != 0 if ply.region_value is None else np.isclose(values, ply.region_value)
+    cells = np.flatnonzero(chosen)
+    if not cells.size:
+        raise OptionsError("region", f"of ply {ply.name!r} holds no cell of the mould")
+    return cells
+
+
+def _submesh(mesh: SurfaceMesh, cells: np.ndarray) -> tuple[SurfaceMesh, np.ndarray]:
+    """The mesh of the given global cells and its nodes' indices on ``mesh``."""
+    if len(cells) == mesh.num_cells:
+        return mesh, np.arange(mesh.num_points)
+    blocks, start = {}, 0
+    for cell_type, block in mesh.cells.items():
+        mine = cells[(cells >= start) & (cells < start + len(block))] - start
+        if mine.size:
+            blocks[cell_type] = block[mine]
+        start += len(block)
+    nodes = np.unique(np.concatenate([b.ravel() for b in blocks.values()]))
+    index = np.full(mesh.num_points, -1)
+    index[nodes] = np.arange(len(nodes))
+    sub = SurfaceMesh(mesh.points[nodes], {t: index[b] for t, b in blocks.items()})
+    return sub, nodes
+
+
+def _drape_one(task: dict[str, Any]) -> dict[str, Any]:
+    """Drape one distinct ply (in a worker process or this one): the pattern and the net."""
+    started = time.perf_counter()
+    mesh = task["mesh"]
+    pattern = solve(
+        mesh, task["material"], 1.0, warp_direction=tuple(task["warp"]), **task["solve"]
+    )
+    kinematic, error = None, None
+    if task["kinematic"] is not None:
+        try:
+            kinematic = drape_ply(mesh, **task["kinematic"])
+        except Exception as exc:  # the net is beside the pattern: its failure is reported
+            error = f"{type(exc).__name__}: {exc}"
+    return {
+        "pattern": pattern,
+        "kinematic": kinematic,
+        "error": error,
+        "seconds": time.perf_counter() - started,
+    }
+
+
+def _limit_threads(threads: int) -> None:
+    for variable in ("MKL_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        os.environ[variable] = str(threads)
+
+
+def _label(orientation: float, taken: Sequence[str]) -> str:
+    base = f"{orientation:g}°"
+    label, count = base, 1
+    while label in taken:
+        count += 1
+        label = f"{base} ({count})"
+    return label
+
+
+def _key(ply: Ply, seed: np.ndarray, cells: np.ndarray) -> tuple:
+    o = ply.options
+    return (
+        round(float(o.orientation) % 360.0, 9),
+        repr(ply.material.parameters) + type(ply.material).__name__,
+        tuple(np.round(seed, 12)),
+        o.fabric_kind,
+        cells.tobytes(),
+    )
+
+
+@takes_options(LaminateOptions)
+def drape_laminate(
+    mesh: SurfaceMesh,
+    plies: Sequence[Ply],
+    options: LaminateOptions | None = None,
+    *,
+    cell_data: Mapping[str, np.ndarray] | None = None,
+    solve_settings: Mapping[str, Any] | None = None,
+    callback: Callable[[PlyDrapeResult], None] | None = None,
+    **settings: Any,
+) -> LaminateResult:
+    """Drape every ply of a laminate on the mould ``mesh`` and check every pair.
+
+    ``plies``: the stack, bottom first (:class:`Ply`); ``options``: a :class:`LaminateOptions`
+    to start from, changed by keyword ``settings`` (below). ``cell_data``: the mould's cell fields
+    ``(m,)`` (a ply's ``region`` names one). ``solve_settings``: options of :func:`vares.solve`
+    for every ply (not ``warp_direction``, which each ply sets). ``callback`` sees each drape as
+    it ends. Distinct plies are draped in parallel by ``workers`` processes when more than one.
+    """
+    (options,) = split_settings(settings, [options or LaminateOptions()])
+    laminate = Laminate(tuple(plies), options)
+    started = time.perf_counter()
+    cell_data = cell_data or {}
+    solve_options = dict(solve_settings or {})
+    solve_options.pop("warp_direction", None)
+    points = mesh.points
+    default_seed = (
+        np.asarray(options.seed, dtype=float)
+        if options.seed is not None
+        else points[np.argmin(np.linalg.norm(points - points.mean(axis=0), axis=1))]
+    )
+    groups: dict[tuple, dict[str, Any]] = {}
+    ply_drape: dict[str, tuple] = {}
+    for ply in laminate.plies:
+        o = ply.options
+        seed = np.asarray(o.seed, dtype=float) if o.seed is not None else default_seed
+        cells = _region_cells(o, cell_data, mesh.num_cells)
+        key = _key(ply, seed, cells)
+        ply_drape[o.name] = key
+        if key in groups:
+            groups[key]["plies"].append(o.name)
+            continue
+        sub, nodes = _submesh(mesh, cells)
+        warp, normal = ply_warp(sub, seed, np.asarray(options.reference), o.orientation)
+        kinematic = None
+        if options.kinematic:
+            kinematic = {
+                "seed": tuple(seed),
+                "warp": tuple(warp),
+                "spacing": options.spacing,
+                "fabric_kind": o.fabric_kind or options.fabric_kind,
+            }
+        label = _label(o.orientation, [g["label"] for g in groups.values()])
+        groups[key] = {
+            "label": label,
+            "plies": [o.name],
+            "ply": ply,
+            "seed": seed,
+            "cells": cells,
+            "nodes": nodes,
+            "normal": normal,
+            "task": {
+                "mesh": sub,
+                "material": ply.material,
+                "warp": warp,
+                "solve": solve_options,
+                "kinematic": kinematic,
+            },
+        }
+    tasks = [g["task"] for g in groups.values()]
+    workers = min(options.workers or os.cpu_count() or 1, len(tasks))
+    if workers > 1:
+        threads = max(1, (os.cpu_count() or 1) // workers)
+        with ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=get_context("spawn"),
+            initializer=_limit_threads,
+            initargs=(threads,),
+        ) as pool:
+            outcomes = list(pool.map(_drape_one, tasks))
+    else:
+        outcomes = [_drape_one(task) for task in tasks]
+    drapes = []
+    for group, outcome in zip(groups.values(), outcomes, strict=True):
+        drape = _drape_result(mesh, group, outcome)
+        drapes.append(drape)
+        if callback is not None:
+            callback(drape)
+    labels = {key: g["label"] for key, g in groups.items()}
+    pairs = {
+        (a.label, b.label): _pair_check(a, b, options.compression_strain)
+        for a in drapes
+        for b in drapes
+    }
+    return LaminateResult(
+        mesh,
+        laminate,
+        drapes,
+        {name: labels[key] for name, key in ply_drape.items()},
+        pairs,
+        time.perf_counter() - started,
+        workers,
+    )
+
+
+def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, Any]):
+    pattern: PatternResult = outcome["pattern"]
+    sub = group["task"]["mesh"]
+    cells = group["cells"]
+    m = mesh.num_cells
+
+    def spread(values: np.ndarray) -> np.ndarray:
+        out = np.full((m, *values.shape[1:]), np.nan)
+        out[cells] = values
+        return out
+
+    warp, fill = draped_yarns(
+        sub, pattern.material_coordinates, pattern.fibres.warp, pattern.fibres.fill
+    )
+    fields = pattern.fields
+    kinematic: PlyDrape | None = outcome["kinematic"]
+    nan3 = np.full((len(cells), 3), np.nan)
+    return PlyDrapeResult(
+        label=group["label"],
+        plies=group["plies"],
+        orientation=float(group["ply"].options.orientation),
+        cells=cells,
+        nodes=group["nodes"],
+        mesh=sub,
+        seed=group["seed"],
+        warp_direction=np.asarray(group["task"]["warp"]),
+        normal=group["normal"],
+        material=group["ply"].material,
+        pattern=pattern,
+        warp=spread(warp),
+        fill=spread(fill),
+        shear_angle=spread(fields["shear_angle"]),
+        kinematic=kinematic,
+        kinematic_error=outcome["error"],
+        kinematic_warp=spread(kinematic.drape.warp if kinematic else nan3),
+        kinematic_fill=spread(kinematic.drape.fill if kinematic else nan3),
+        kinematic_shear_angle=spread(
+            kinematic.drape.shear_angle if kinematic else np.full(len(cells), np.nan)
+        ),
+        seconds=outcome["seconds"],
+    )
+
+
+def _angle_of(vector: np.ndarray) -> float:
+    return float(np.degrees(np.arctan2(vector[1], vector[0])))
+
+
+def _pair_check(blank: PlyDrapeResult, ply: PlyDrapeResult, strain: float) -> PairCheck:
+    """The blank of ``blank`` erected with the yarns of ``ply`` (module docs)."""
+    if not np.array_equal(blank.cells, ply.cells):
+        return PairCheck(blank.label, ply.label, False)
+    pattern = blank.pattern
+    turn = ply.orientation - blank.orientation
+    own = ply.pattern.fibres
+    warp_angle = _angle_of(pattern.fibres.warp) + turn
+    fill_angle = warp_angle + _angle_of(own.fill) - _angle_of(own.warp)
+    check = evaluate(
+        blank.mesh,
+        pattern.material_coordinates,
+        ply.material,
+        warp_angle=warp_angle,
+        fill_angle=fill_angle,
+    )
+    f = check.fields
+    area = f["surface_area"]
+    total = area.sum()
+    warp_short = f["warp_stretch"] < 1.0 - strain
+    fill_short = f["fill_stretch"] < 1.0 - strain
+    compression = 1.0 - np.minimum(f["warp_stretch"], f["fill_stretch"])
+    erected, _ = draped_yarns(
+        blank.mesh, pattern.material_coordinates, check.fibres.warp, check.fibres.fill
+    )
+    target = ply.warp[ply.cells]
+    deviation = np.degrees(
+        np.arctan2(
+            np.linalg.norm(np.cross(erected, target), axis=1),
+            np.abs(np.einsum("mi,mi->m", erected, target)),
+        )
+    )
+    return PairCheck(
+        blank.label,
+        ply.label,
+        True,
+        compressed_area_fraction=float(area[warp_short | fill_short].sum() / total),
+        warp_compressed_fraction=float(area[warp_short].sum() / total),
+        fill_compressed_fraction=float(area[fill_short].sum() / total),
+        largest_compression=float(max(compression.max(), 0.0)),
+        min_yarn_stress=float(min(f["warp_stress"].min(), f["fill_stress"].min())),
+        mean_deviation=float(area @ deviation / total),
+        max_deviation=float(deviation.max()),
+        energy=float(check.energy),
+    )

@@ -1,0 +1,139 @@
+"""The options of a laminate and of each of its plies, declared once (see :mod:`vares.options`):
+the ``[laminate]`` table and the ``[[ply]]`` tables of a laminate job, and the keywords of
+:func:`vares.structures.laminate.drape_laminate` and :class:`vares.structures.laminate.Ply`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..materials.forming import FABRIC_KINDS
+from ..options import Options, OptionsError, option
+
+__all__ = ["LaminateOptions", "PlyOptions"]
+
+
+@dataclass(frozen=True)
+class LaminateOptions(Options):
+    """What the plies of a laminate share: the reference direction on the mould, the default
+    seed, the kinematic net's spacing, the ply-stack check's threshold and the workers."""
+
+    title = "laminate option"
+
+    reference: tuple[float, float, float] = option(
+        (1.0, 0.0, 0.0),
+        "vector",
+        "Reference direction 'x,y,z' on the mould: a ply's orientation is measured from it "
+        "(projected onto the mould at the seed), counter-clockwise about the surface normal.",
+        section="laminate",
+    )
+    seed: tuple[float, float, float] | None = option(
+        None,
+        "vector",
+        "Seed point 'x,y,z' of every ply that names none (default: the mould's node nearest the "
+        "nodes' centroid).",
+        section="laminate",
+    )
+    spacing: float | None = option(
+        None,
+        "float",
+        "Yarn spacing of the kinematic net, mesh length units (default: half the mean edge "
+        "length).",
+        section="laminate",
+        positive=True,
+    )
+    fabric_kind: str = option(
+        "ncf-biaxial",
+        "str",
+        "Fabric kind of every ply that names none: its typical locking angle (docs/composites.md).",
+        section="laminate",
+        choices=tuple(FABRIC_KINDS),
+    )
+    kinematic: bool = option(
+        True,
+        "bool",
+        "Drape every ply kinematically (pin-jointed net) beside the mechanical pattern.",
+        section="laminate",
+        flags=("--kinematic/--no-kinematic",),
+    )
+    compression_strain: float = option(
+        1e-3,
+        "float",
+        "Ply-stack check: a yarn shortened by more than this strain (1e-3 = 0.1 %) counts as "
+        "compressed.",
+        section="laminate",
+        positive=True,
+    )
+    workers: int | None = option(
+        None,
+        "int",
+        "Processes that drape the plies at once (default: one per core, at most one per "
+        "distinct ply; 1: in this process).",
+        section="laminate",
+        positive=True,
+    )
+
+
+@dataclass(frozen=True)
+class PlyOptions(Options):
+    """One ply of a laminate: its name, fabric, orientation, seed, region and drop-off order."""
+
+    title = "ply option"
+
+    name: str = option(None, "str", "The ply's name (unique in the laminate).", section="ply")
+    orientation: float = option(
+        0.0,
+        "float",
+        "Warp angle in degrees from the laminate's reference direction, counter-clockwise about "
+        "the mould's normal at the seed.",
+        section="ply",
+    )
+    fabric: str | None = option(
+        None,
+        "str",
+        "Fabric preset or fabric file (.toml) of the ply (default: the job's [material]).",
+        section="ply",
+    )
+    material: str | None = option(
+        None,
+        "str",
+        "Name of a [materials.NAME] table of the job that holds the ply's material.",
+        section="ply",
+    )
+    fabric_kind: str | None = option(
+        None,
+        "str",
+        "Fabric kind for the locking angle (default: the laminate's).",
+        section="ply",
+        choices=tuple(FABRIC_KINDS),
+    )
+    seed: tuple[float, float, float] | None = option(
+        None, "vector", "Seed point 'x,y,z' (default: the laminate's).", section="ply"
+    )
+    region: str | None = option(
+        None,
+        "str",
+        "Cell field of the mould that marks the ply's cells (default: the whole mould).",
+        section="ply",
+    )
+    region_value: float | None = option(
+        None,
+        "float",
+        "The value of the region field on the ply's cells (default: every non-zero value).",
+        section="ply",
+    )
+    drop_off: int | None = option(
+        None,
+        "int",
+        "Drop-off order: 1 for the ply that ends first, 2 the next, … (default: runs over the "
+        "whole part).",
+        section="ply",
+        positive=True,
+    )
+
+    def check(self) -> None:
+        if not self.name:
+            raise OptionsError("name", "must be a non-empty string")
+        if self.fabric is not None and self.material is not None:
+            raise OptionsError(None, "give a ply a fabric or a material, not both")
+        if self.region_value is not None and self.region is None:
+            raise OptionsError("region_value", "needs a region field")
