@@ -473,3 +473,15 @@ def test_a_file_that_is_no_test_record_says_what_it_is(tmp_path):
             read_biaxial(path)
     result = run("fabric", "fit", sheet, "-o", tmp_path / "f.toml")
     assert result.exit_code == 2 and "export the record as text (CSV or TSV)" in error_line(result)
+
+
+def test_fabric_fit_says_what_a_flag_needs():
+    record = Path(__file__).parent.parent / "examples" / "biaxial" / "pes-42-A_msaj.csv"
+    out = Path("never-written.toml")
+    result = run("fabric", "fit", record, "-o", out, "--compensate-by", "measured")
+    assert result.exit_code == 2 and "--compensate-by measured needs --prestress" in error_line(
+        result
+    )
+    result = run("fabric", "fit", record, "-o", out, "--cycle", "0")
+    assert result.exit_code == 2 and "cycles count from 1; -1 is the last" in error_line(result)
+    assert not out.exists()

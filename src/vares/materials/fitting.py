@@ -132,7 +132,7 @@ def _branches(record: BiaxialRecord, cycle: int) -> list[tuple[Cycle, np.ndarray
         else:
             raise RecordError(
                 f"{record.name}: stage {stage} ({members[0].label}) has {len(members)} "
-                f"cycle(s); cycle {cycle} asked"
+                f"cycle(s); cycle {cycle} asked (cycles count from 1; -1 is the last)"
             )
         chosen.append((pick, np.arange(pick.start, pick.loaded + 1)))
     return chosen

@@ -110,6 +110,11 @@ def fit(
         if compensate_by not in (None, "measured", "law"):
             raise InputError(f"--compensate-by takes measured or law; got {compensate_by!r}")
         pair = _pair(prestress, "--prestress")
+        if compensate_by == "measured" and pair is None:
+            raise InputError(
+                "--compensate-by measured needs --prestress: the compensation values are read "
+                "at the prestress the compensation records (EN 17117-2) hold"
+            )
         check_writable([output], force)
         if G12 is not None:
             if not G12 > 0:
