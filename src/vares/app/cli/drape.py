@@ -38,9 +38,7 @@ def drape(
     """
 
     def body() -> None:
-        import numpy as np  # when the command runs
-
-        from ...analysis.drape import drape_ply
+        from ...analysis.drape import drape_ply  # when the command runs
         from ...analysis.producibility import CLASSES
         from ...io.files import write_json
         from ...io.meshes import read_mesh, write_surface
@@ -57,13 +55,10 @@ def drape(
         ply = drape_ply(mesh, options)
         check, result = ply.producibility, ply.drape
         data = {"surface": str(surface), **ply.summary()}
-        codes = np.zeros(len(check.classes))
-        for code, name in enumerate(CLASSES):
-            codes[check.classes == name] = code
         data["producibility_codes"] = {name: code for code, name in enumerate(CLASSES)}
         fields = {
             "shear_angle": result.shear_angle,
-            "producibility": codes,
+            "producibility": ply.fields()["producibility"],
             "warp": result.warp,
             "fill": result.fill,
         }
