@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.drape import PlyDrape, drape_ply
-from ..analysis.evaluate import evaluate
+from ..analysis.evaluate import PatternEvaluation, evaluate
 from ..geometry.elements import ELEMENTS, inverse
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
@@ -38,6 +38,8 @@ from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
 
 __all__ = [
+    "PAIR_VALUES",
+    "PARALLEL_CELLS",
     "Laminate",
     "LaminateOptions",
     "LaminateResult",
@@ -45,10 +47,17 @@ __all__ = [
     "Ply",
     "PlyDrapeResult",
     "PlyOptions",
+    "blank_used_for",
     "drape_laminate",
     "draped_yarns",
     "ply_warp",
 ]
+
+
+#: Moulds of fewer cells are draped in the calling process unless ``workers`` says otherwise:
+#: a worker's start (importing vares, loading its compiled kernels: 3–5 s) costs more than their
+#: plies' solves (docs/composites.md, "In parallel").
+PARALLEL_CELLS = 4000
 
 
 @dataclass(frozen=True)
@@ -398,7 +407,8 @@ def drape_laminate(
     to start from, changed by keyword ``settings`` (below). ``cell_data``: the mould's cell fields
     ``(m,)`` (a ply's ``region`` names one). ``solve_settings``: options of :func:`vares.solve`
     for every ply (not ``warp_direction``, which each ply sets). ``callback`` sees each drape as
-    it ends. Distinct plies are draped in parallel by ``workers`` processes when more than one.
+    it ends. Distinct plies are draped in parallel by ``workers`` processes when more than one
+    (default: one per core for a mould of at least :data:`PARALLEL_CELLS` cells, else one).
     """
     (options,) = split_settings(settings, [options or LaminateOptions()])
     laminate = Laminate(tuple(plies), options)
@@ -451,7 +461,8 @@ def drape_laminate(
             },
         }
     tasks = [g["task"] for g in groups.values()]
-    workers = min(options.workers or os.cpu_count() or 1, len(tasks))
+    default = (os.cpu_count() or 1) if mesh.num_cells >= PARALLEL_CELLS else 1
+    workers = min(options.workers or default, len(tasks))
     if workers > 1:
         threads = max(1, (os.cpu_count() or 1) // workers)
         with ProcessPoolExecutor(
@@ -533,22 +544,32 @@ def _angle_of(vector: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(vector[1], vector[0])))
 
 
-def _pair_check(blank: PlyDrapeResult, ply: PlyDrapeResult, strain: float) -> PairCheck:
-    """The blank of ``blank`` erected with the yarns of ``ply`` (module docs)."""
+def blank_used_for(blank: PlyDrapeResult, ply: PlyDrapeResult) -> PatternEvaluation:
+    """The blank of ``blank`` erected with the material and yarns of ``ply``: ``ply``'s yarns at
+    ``θ_ply − θ_blank`` in the blank's pattern frame (:func:`vares.evaluate`; its per-cell
+    ``fields`` are those of ``blank.mesh``). Both must cover the same cells."""
     if not np.array_equal(blank.cells, ply.cells):
-        return PairCheck(blank.label, ply.label, False)
+        raise ValueError(f"drapes {blank.label} and {ply.label} cover different cells")
     pattern = blank.pattern
     turn = ply.orientation - blank.orientation
     own = ply.pattern.fibres
     warp_angle = _angle_of(pattern.fibres.warp) + turn
     fill_angle = warp_angle + _angle_of(own.fill) - _angle_of(own.warp)
-    check = evaluate(
+    return evaluate(
         blank.mesh,
         pattern.material_coordinates,
         ply.material,
         warp_angle=warp_angle,
         fill_angle=fill_angle,
     )
+
+
+def _pair_check(blank: PlyDrapeResult, ply: PlyDrapeResult, strain: float) -> PairCheck:
+    """The blank of ``blank`` erected with the yarns of ``ply`` (module docs)."""
+    if not np.array_equal(blank.cells, ply.cells):
+        return PairCheck(blank.label, ply.label, False)
+    pattern = blank.pattern
+    check = blank_used_for(blank, ply)
     f = check.fields
     area = f["surface_area"]
     total = area.sum()

@@ -66,8 +66,8 @@ class LaminateOptions(Options):
     workers: int | None = option(
         None,
         "int",
-        "Processes that drape the plies at once (default: one per core, at most one per "
-        "distinct ply; 1: in this process).",
+        "Processes that drape the plies at once, at most one per distinct ply (default: one per "
+        "core for a mould of at least 4000 cells, else 1: in this process).",
         section="laminate",
         positive=True,
     )

@@ -21,8 +21,8 @@ def laminate(
         typer.Option(
             "--workers",
             min=1,
-            help="Processes that drape the plies at once (default: the job's [laminate] "
-            "workers, else one per core).",
+            help="Processes that drape the plies at once (default: the workers of the job's "
+            "laminate table, else one per core for a mould of 4000 cells or more).",
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", "-f", help="Overwrite output files.")] = False,
@@ -30,9 +30,10 @@ def laminate(
 ) -> None:
     """Drape every ply of a laminate (mechanical pattern and kinematic net) and check every pair.
 
-    Writes laminate.json, laminate.md (the pair matrices), laminate.vtu (the draped warp and fill
-    per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply), orientations.csv and
-    patterns/<drape>.vtu into the output directory. Exit status 1 when a ply did not converge.
+    Writes laminate.json, laminate.md (the pair matrices), laminate.vtu (the draped warp and
+    fill per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply),
+    orientations.csv and patterns/drape_ANGLEdeg.vtu into the output directory. Exit status 1
+    when a ply did not converge.
     """
 
     def body() -> None:
