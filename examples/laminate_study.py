@@ -115,7 +115,9 @@ def main() -> None:
         image = ax.imshow(matrix, cmap="Reds", vmin=0)
         for i in range(len(labels)):
             for j in range(len(labels)):
-                ax.text(j, i, f"{matrix[i, j]:.1f}", ha="center", va="center", fontsize=8)
+                colour = "white" if matrix[i, j] > 0.5 * matrix.max() else "black"
+                text = f"{matrix[i, j]:.1f}"
+                ax.text(j, i, text, ha="center", va="center", fontsize=8, color=colour)
         ax.set_xticks(range(len(labels)), labels)
         ax.set_yticks(range(len(labels)), labels)
         ax.set_xlabel("used for the ply")

@@ -1,5 +1,5 @@
-"""Whole structures: panels, the seams between them, patterns whose seams match, and a surface
-cut into strips of roll width and nested on the roll."""
+"""Whole structures: panels, the seams between them, patterns whose seams match, a surface cut
+into strips of roll width and nested on the roll, and laminates (stacks of plies on a mould)."""
 
 from typing import TYPE_CHECKING
 
@@ -7,6 +7,8 @@ from .._lazy import lazy_exports
 
 if TYPE_CHECKING:
     from .cutting import CutResult, cut
+    from .laminate import Laminate, LaminateResult, Ply, drape_laminate
+    from .laminate_options import LaminateOptions, PlyOptions
     from .matching import MatchingRecord, StructureResult, solve_structure
     from .options import CutOptions, StructureOptions
     from .panels import Panel, split_panels, width_across_warp
