@@ -258,3 +258,49 @@ def test_cli_names_the_closest_key(job_folder):
     done = run("laminate", bad, "-o", job_folder / "bad-out")
     assert done.exit_code == 2
     assert "did you mean 'orientation'" in error_line(done)
+
+
+def test_a_ply_with_its_own_seed_is_draped_from_there():
+    mesh = mould()
+    seed = mesh.points[np.argmin(np.linalg.norm(mesh.points - [2.0, 1.0, 0.0], axis=1))]
+    plies = [
+        Ply(PlyOptions(name="top", orientation=30.0), NCF),
+        Ply(PlyOptions(name="side", orientation=30.0, seed=tuple(seed)), NCF),
+    ]
+    result = drape_laminate(mesh, plies, workers=1, kinematic=False)
+    assert result.labels == ["30°", "30° (2)"]
+    side = result.drape("side")
+    np.testing.assert_allclose(side.seed, seed)
+    warp, normal = ply_warp(mesh, seed, np.array([1.0, 0.0, 0.0]), 30.0)
+    np.testing.assert_allclose(side.warp_direction, warp)
+    assert abs(warp @ normal) < 1e-12 and normal[2] < 0.99  # the cap's slope there
+    assert result.converged
+
+
+def test_abaqus_names_are_labels_and_unique():
+    from vares.io.orientations import abaqus_name
+
+    assert abaqus_name("P1") == "P1"
+    assert abaqus_name("0° ply") == "PLY_0__PLY"
+    assert abaqus_name("p 1", ["P_1"]) == "P_1_2"
+
+
+def test_the_shipped_example(tmp_path):
+    from pathlib import Path
+
+    job = load_laminate_job(Path(__file__).parents[1] / "examples" / "laminate" / "laminate.toml")
+    assert [p.orientation for p in job.plies] == [0.0, 45.0, -45.0, 90.0, 90.0, -45.0, 45.0, 0.0]
+    result = run_laminate(job.with_output(tmp_path / "out"), workers=1)
+    assert result.converged and result.labels == ["0°", "45°", "-45°", "90°"]
+    warp = result.pair_matrix("warp_compressed_fraction")
+    largest = result.pair_matrix("largest_compression")
+    for blank in (1, 2):  # ±45° blanks used for 0° and 90° plies
+        for ply in (0, 3):
+            assert warp[blank, ply] > 0.4 and largest[blank, ply] > 0.04
+    assert np.diag(largest).max() < 0.002
+    read = read_abaqus_orientations(tmp_path / "out" / "orientations.inp")
+    assert len(read) == 8
+    for name, ply in read.items():
+        drape = result.drape(name)
+        np.testing.assert_allclose(ply.warp, drape.warp[ply.elements - 1], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(ply.fill, drape.fill[ply.elements - 1], rtol=0, atol=1e-9)
