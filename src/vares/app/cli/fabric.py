@@ -89,7 +89,9 @@ def fit(
             "load ratio into this folder (PNG)."
         ),
     ] = None,
-    force: Annotated[bool, typer.Option("--force", help="Overwrite the output file.")] = False,
+    force: Annotated[
+        bool, typer.Option("--force", "-f", help="Overwrite the output file.")
+    ] = False,
 ) -> None:
     """Fit a fabric to biaxial test records and write a fabric file for --fabric.
 
