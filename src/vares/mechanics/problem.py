@@ -16,8 +16,10 @@ from ..geometry.elements import ELEMENTS
 from ..geometry.flatten import inverted_cells
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic, MaterialError
+from .assembly import Connectivity
 from .kernels import block_energy, determinant, projected_hessian
 from .prestress import prestress_components, prestress_tensor
+from .yarn_smoothing import YARN_STRAINS, YarnSmoothing
 
 __all__ = ["Evaluation", "Problem", "first_positive_root"]
 
@@ -52,6 +54,14 @@ class Problem:
         [, shear]) or one such row per cell (see :func:`vares.prestress.prestress_components`).
     points
         Surface node positions to use instead of ``mesh.points`` (pseudo-time stepping).
+    yarn_strain
+        ``"element"``: the law per quadrature point; ``"smoothed"``: the yarn stretches of a
+        fibre law averaged over node patches, the shear per cell (no intra-ply shear locking; see
+        :mod:`vares.mechanics.yarn_smoothing`). The per-block arrays then end with the patch
+        block, assembled over :attr:`connectivity`.
+    yarn_stabilisation
+        With ``"smoothed"``: the share of the yarn part kept per cell (see
+        :class:`~vares.mechanics.yarn_smoothing.YarnSmoothing`).
     """
 
     def __init__(
@@ -63,7 +73,11 @@ class Problem:
         fibres: Fibres | None = None,
         prestress: np.ndarray | None = None,
         points: np.ndarray | None = None,
+        yarn_strain: str = "element",
+        yarn_stabilisation: float = 0.0,
     ) -> None:
+        if yarn_strain not in YARN_STRAINS:
+            raise ValueError(f"yarn_strain must be one of {YARN_STRAINS}; got {yarn_strain!r}")
         if not (np.isfinite(thickness) and thickness > 0):
             raise ValueError(f"thickness must be a finite positive number; got {thickness!r}")
         if material.needs_fibres and fibres is None:
@@ -85,6 +99,13 @@ class Problem:
             raise ValueError("a prestress along the yarns needs fibre directions")
         self._prestress_blocks = self._split_prestress(self.prestress)
         self._metrics = [ELEMENTS[t].metrics(centred, cells) for t, cells in mesh.cells.items()]
+        self.yarn_strain = yarn_strain
+        self.yarn_stabilisation = float(yarn_stabilisation)
+        self._smoothing = (
+            YarnSmoothing(mesh, material, fibres, self.thickness, yarn_stabilisation)
+            if yarn_strain == "smoothed"
+            else None
+        )
 
     def _split_prestress(self, components: np.ndarray | None) -> list[np.ndarray | None]:
         """``S_pre`` per block, broadcastable to ``(m, q, 2, 2)``."""
@@ -112,7 +133,15 @@ class Problem:
             fibres=self.fibres,
             prestress=prestress,
             points=points,
+            yarn_strain=self.yarn_strain,
+            yarn_stabilisation=self.yarn_stabilisation,
         )
+
+    @property
+    def connectivity(self) -> SurfaceMesh | Connectivity:
+        """What the per-block arrays of :meth:`evaluate` are assembled over: the mesh, or with
+        smoothed yarn strains the mesh's blocks and the node patches."""
+        return self.mesh if self._smoothing is None else self._smoothing.connectivity
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(
@@ -124,6 +153,15 @@ class Problem:
         ``projected`` the Hessians are made positive semi-definite quadrature point by
         quadrature point (see :meth:`projected_hessians`).
         """
+        if self._smoothing is not None:
+            energies, gradients, hessians, stored = self._smoothing.evaluate(
+                coordinates, self._metrics, self._prestress_blocks, order
+            )
+            total = float(sum(np.sum(e).real for e in energies))
+            evaluation = Evaluation(total, energies, gradients, hessians, stored)
+            if projected and order >= 2:
+                evaluation = replace(evaluation, hessians=self.projected_hessians(evaluation))
+            return evaluation
         energies, gradients, hessians, jacobian_hessians = [], [], [], []
         for (cell_type, cells), metric, prestress in zip(
             self.mesh.cells.items(), self._metrics, self._prestress_blocks, strict=True
@@ -156,7 +194,11 @@ class Problem:
 
     def projected_hessians(self, evaluation: Evaluation) -> list[np.ndarray]:
         """The per-block Hessians of an (order 2) evaluation made positive semi-definite point by
-        point (projected Newton), from its stored ``∂²W/∂J²``: nothing is evaluated again."""
+        point (projected Newton), from its stored ``∂²W/∂J²``: nothing is evaluated again.
+        With smoothed yarn strains the last block, the node patches', is projected through
+        ``∂²Ψ/∂Ĩ²`` (see :meth:`~vares.mechanics.yarn_smoothing.YarnSmoothing.projected`)."""
+        if self._smoothing is not None:
+            return self._smoothing.projected(evaluation.jacobian_hessians)
         return [
             projected_hessian(ELEMENTS[t], h, self.thickness)
             for t, h in zip(self.mesh.cells, evaluation.jacobian_hessians, strict=True)

@@ -1,0 +1,126 @@
+"""Intra-ply shear locking of a stiff-yarn ply on a hemisphere (issue 22, item 1).
+
+A woven ply (orthotropic St. Venant–Kirchhoff, E1 = E2 = ratio × G12, ν12 = 0) on a hemisphere of
+radius 100 mm cut at the equator, irregular triangles (``irregular_cap(100, 90, rings, 0.3, 1)``),
+warp along x. The yarn shear angle along the four 45° meridians (cells whose centroid lies within
+3° of the meridian's azimuth and 2.5° of the polar angle, signed so that all four are positive)
+against the kinematic net of the exact sphere, for the cell-wise law (``yarn_strain="element"``,
+what ``vares.solve`` does) and node-smoothed yarn stretches (``yarn_strain="smoothed"``), both
+started from the kinematic net's pattern on the same mesh, the warp aligned with x by the
+solver's secant iteration.
+
+    python benchmarks/locking.py                      # 40 rings (9,600 cells), E/G 1e4 and 1e6
+    python benchmarks/locking.py --rings 20 30 40 60  # the mesh-convergence table
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from vares.analysis.locking import cell_shear_angle, meridian_shear, solve_yarn_strain
+from vares.geometry.drape import kinematic_drape
+from vares.geometry.examples import irregular_cap
+from vares.materials import OrthotropicStVenantKirchhoff
+
+POLAR = (30.0, 45.0, 60.0, 75.0)
+#: Kinematic net on the exact sphere, seed at the pole, warp along x (docs/composites.md) [°].
+NET = np.array([7.52, 16.11, 26.95, 39.27])
+
+
+def mesh_net(rings: int) -> tuple[np.ndarray, np.ndarray]:
+    """The kinematic net on the same mesh (spacing 1 mm), sampled as the solves are, and the flat
+    pattern it implies (the solves' start)."""
+    mesh = irregular_cap(100.0, 90.0, rings, 0.3, 1)
+    drape = kinematic_drape(mesh, seed=(0, 0, 100), warp_direction=(1, 0, 0), spacing=1.0)
+    return meridian_shear(mesh, drape.shear_angle, polar_angles=POLAR), drape.material_coordinates
+
+
+def run(
+    rings: int,
+    ratio: float,
+    yarn_strain: str,
+    stabilisation: float,
+    net: np.ndarray,
+    start: np.ndarray,
+) -> dict:
+    mesh = irregular_cap(100.0, 90.0, rings, 0.3, 1)
+    material = OrthotropicStVenantKirchhoff(E1=ratio, E2=ratio, G12=1.0, nu12=0.0)
+    result = solve_yarn_strain(
+        mesh,
+        material,
+        yarn_strain=yarn_strain,
+        yarn_stabilisation=stabilisation / ratio if yarn_strain == "smoothed" else 0.0,
+        warp_direction=(1, 0, 0),
+        initial_guess=start,
+    )
+    shear = cell_shear_angle(mesh, result.coordinates, material, result.fibres)
+    table = meridian_shear(mesh, shear, polar_angles=POLAR)
+    return {
+        "cells": mesh.num_cells,
+        "converged": result.converged,
+        "iterations": result.iterations,
+        "seconds": result.elapsed,
+        "table": table,
+        "spread": np.nanmax(table, axis=0) - np.nanmin(table, axis=0),
+        "error": np.nanmax(np.abs(table - NET), axis=0),
+        "mesh_error": np.nanmax(np.abs(table - net), axis=0),
+        "mean": np.nanmean(table, axis=0),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rings", type=int, nargs="+", default=[40])
+    parser.add_argument("--ratios", type=float, nargs="+", default=[1e4, 1e6])
+    parser.add_argument("--yarn-strain", nargs="+", default=["element", "smoothed"])
+    parser.add_argument(
+        "--stabilisation",
+        type=float,
+        default=0.0,
+        help="share of the yarn part kept per cell, times E/G (smoothed only)",
+    )
+    args = parser.parse_args()
+    print("net (exact sphere)  " + "  ".join(f"{v:6.2f}" for v in NET))
+    rows = []
+    for rings in args.rings:
+        net, start = mesh_net(rings)
+        print(f"\nnet on the {rings}-ring mesh")
+        for azimuth, line in zip((45, 135, 225, 315), net, strict=True):
+            print(f"  meridian {azimuth:3d}°     " + "  ".join(f"{v:6.2f}" for v in line))
+        spread = np.nanmax(net, axis=0) - np.nanmin(net, axis=0)
+        print("  spread of the 4   " + "  ".join(f"{v:6.2f}" for v in spread))
+        for ratio in args.ratios:
+            for yarn_strain in args.yarn_strain:
+                r = run(rings, ratio, yarn_strain, args.stabilisation, net, start)
+                rows.append((rings, ratio, yarn_strain, r))
+                print(
+                    f"\n{rings} rings ({r['cells']} cells), E/G = {ratio:.0e}, {yarn_strain}: "
+                    f"converged {r['converged']}, {r['iterations']} iterations, "
+                    f"{r['seconds']:.1f} s"
+                )
+                print("polar angle         " + "  ".join(f"{p:6.0f}" for p in POLAR))
+                for azimuth, line in zip((45, 135, 225, 315), r["table"], strict=True):
+                    print(f"  meridian {azimuth:3d}°     " + "  ".join(f"{v:6.2f}" for v in line))
+                print("  spread of the 4   " + "  ".join(f"{v:6.2f}" for v in r["spread"]))
+                print("  mean of the 4     " + "  ".join(f"{v:6.2f}" for v in r["mean"]))
+                print("  max |Δ net|       " + "  ".join(f"{v:6.2f}" for v in r["error"]))
+                print("  max |Δ mesh net|  " + "  ".join(f"{v:6.2f}" for v in r["mesh_error"]))
+    print(
+        "\n| rings | cells | E/G | yarn strain | iterations | s | spread (30/45/60/75°) | "
+        "max abs. error vs net |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    for rings, ratio, yarn_strain, r in rows:
+        spread = " / ".join(f"{v:.2f}" for v in r["spread"])
+        error = " / ".join(f"{v:.2f}" for v in r["error"])
+        mesh_error = " / ".join(f"{v:.2f}" for v in r["mesh_error"])
+        print(
+            f"| {rings} | {r['cells']} | {ratio:.0e} | {yarn_strain} | {r['iterations']} | "
+            f"{r['seconds']:.1f} | {spread} | {error} | {mesh_error} |"
+        )
+
+
+if __name__ == "__main__":
+    main()

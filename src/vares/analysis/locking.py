@@ -1,0 +1,176 @@
+"""Stiff-yarn plies on linear cells: a solve with a chosen yarn-strain treatment, and the shear
+along the meridians of a cap (the intra-ply shear locking check of DESIGN.md §8).
+
+:func:`solve_yarn_strain` runs the strategy of :func:`vares.solve` (its initial guess, plan and
+warp alignment) on a :class:`~vares.mechanics.problem.Problem` with ``yarn_strain`` set, assembled
+over the problem's connectivity; :func:`meridian_shear` samples a per-cell field along
+meridians of a surface of revolution about the z axis.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.mesh import SurfaceMesh
+from ..materials import Fibres, Hyperelastic
+from ..mechanics.assembly import Assembler
+from ..mechanics.fields import cell_fields
+from ..mechanics.problem import Problem
+from ..mechanics.rigid import rigid_modes
+from ..solver.alignment import align_warp, fibre_angle, initial_fibres, rotated
+from ..solver.linear import get_solver, quiet_blas
+from ..solver.newton import Failure, NewtonContext
+from ..solver.options import SolveOptions
+from ..solver.result import IterationRecord
+from ..solver.start import initial_guess as first_guess
+from ..solver.strategies import follow_plan, plan
+
+__all__ = ["SmoothedSolve", "cell_shear_angle", "meridian_shear", "solve_yarn_strain"]
+
+
+@dataclass
+class SmoothedSolve:
+    """A pattern ``(n, 2)`` (warp along +x when a warp direction was given), its fibres and
+    problem, whether it converged, the Newton iterations, and the seconds it took."""
+
+    coordinates: np.ndarray
+    fibres: Fibres
+    problem: Problem
+    converged: bool
+    reason: str | None
+    iterations: int
+    elapsed: float
+    history: list[IterationRecord] = field(default_factory=list)
+
+
+def solve_yarn_strain(
+    mesh: SurfaceMesh,
+    material: Hyperelastic,
+    thickness: float = 1.0,
+    *,
+    prestress: float | Sequence[float] | np.ndarray | None = None,
+    yarn_strain: str = "smoothed",
+    yarn_stabilisation: float = 0.0,
+    warp_direction: Sequence[float] | None = None,
+    initial_guess: np.ndarray | None = None,
+    options: SolveOptions | None = None,
+) -> SmoothedSolve:
+    """The cutting pattern of ``mesh`` with the yarn strains treated as ``yarn_strain`` says
+    (``"element"`` is the formulation :func:`vares.solve` uses) and ``yarn_stabilisation`` the
+    share of the yarn part kept per cell (:class:`~vares.mechanics.yarn_smoothing.YarnSmoothing`).
+
+    The strategy and initial guess of ``options`` (default :class:`SolveOptions`), or the given
+    ``initial_guess`` ``(n, 2)`` (e.g. the kinematic net's pattern,
+    :func:`vares.geometry.drape.kinematic_drape`); ``prestress`` as for :func:`vares.solve`;
+    with ``warp_direction`` (a 3D direction) the yarns are turned until the mean erected warp
+    follows it.
+    """
+    options = options or SolveOptions()
+    started = time.perf_counter()
+    with quiet_blas():
+        start = first_guess(mesh, options, initial_guess)
+        fibres = Fibres.from_angles(options.warp_angle, options.fill_angle)
+
+        def make_problem(f: Fibres) -> Problem:
+            return Problem(
+                mesh,
+                material,
+                thickness,
+                fibres=f,
+                prestress=prestress,
+                yarn_strain=yarn_strain,
+                yarn_stabilisation=yarn_stabilisation,
+            )
+
+        problem = make_problem(fibres)
+        free, constraint = rigid_modes(start.coordinates, options.orientation)
+        history: list[IterationRecord] = []
+        ctx = NewtonContext(
+            assembler=Assembler(problem.connectivity, free),
+            linear_solver=get_solver(options.linear_solver),
+            residual_tolerance=options.tolerance * problem.force_scale,
+            energy_noise=1e-13 * material.stiffness_scale * thickness * mesh.area,
+            force_scale=problem.force_scale,
+            max_iterations=options.max_iterations,
+            history=history,
+            steps=[],
+            callback=None,
+            constraint=constraint,
+        )
+        x = start.coordinates
+        direction = None if warp_direction is None else np.asarray(warp_direction, float)
+        if direction is not None:
+            fibres = initial_fibres(fibres, options.warp_angle, x, problem, direction)
+            problem = make_problem(fibres)
+        attempts = plan(options.strategy, options.steps, start.plane is not None)
+        x, _, reason = follow_plan(problem, x, start.plane, attempts, ctx, options.damping)
+        if reason is None and direction is not None:
+            try:
+                x, fibres, _ = align_warp(make_problem, x, fibres, direction, ctx, options.damping)
+            except Failure as failure:
+                reason, x = failure.reason, failure.coordinates
+            turn = fibre_angle(fibres.warp)
+            x = rotated(x, -turn)
+            fibres = Fibres.from_angles(0.0, fibre_angle(fibres.fill) - turn)
+            problem = make_problem(fibres)
+    iterations = sum(1 for record in history if record.iteration > 0)
+    return SmoothedSolve(
+        x,
+        fibres,
+        problem,
+        reason is None,
+        reason,
+        iterations,
+        time.perf_counter() - started,
+        history,
+    )
+
+
+def cell_shear_angle(
+    mesh: SurfaceMesh, coordinates: np.ndarray, material: Hyperelastic, fibres: Fibres
+) -> np.ndarray:
+    """Yarn shear angle per cell [°] ``(m,)`` (``shear_angle`` of
+    :func:`vares.mechanics.cell_fields`; the shear part is per cell in both treatments)."""
+    return cell_fields(mesh, coordinates, material, 1.0, fibres=fibres)["shear_angle"]
+
+
+def meridian_shear(
+    mesh: SurfaceMesh,
+    values: np.ndarray,
+    azimuths: Sequence[float] = (45.0, 135.0, 225.0, 315.0),
+    polar_angles: Sequence[float] = (30.0, 45.0, 60.0, 75.0),
+    *,
+    azimuth_width: float = 3.0,
+    polar_width: float = 2.5,
+    signed: bool = True,
+) -> np.ndarray:
+    """Mean of a per-cell field along meridians of a surface about the z axis,
+    ``(len(azimuths), len(polar_angles))``.
+
+    A meridian's sample at polar angle ``θ`` [°] is the mean over the cells whose centroid lies
+    within ``azimuth_width`` degrees of the azimuth and ``polar_width`` degrees of ``θ``
+    (NaN where none does). With ``signed`` the values are multiplied by the sign of
+    ``sin 2φ``: the shear of a net seeded at the pole with the warp along x is
+    ``γ = ∬ K dA`` over signed yarn lengths, of opposite signs in neighbouring quadrants.
+    """
+    cells = np.concatenate([c for c in mesh.cells.values()]) if len(mesh.cells) == 1 else None
+    if cells is not None:
+        centroids = mesh.points[cells].mean(axis=1)
+    else:
+        centroids = np.concatenate([mesh.points[c].mean(axis=1) for c in mesh.cells.values()])
+    radius = np.linalg.norm(centroids, axis=1)
+    polar = np.degrees(np.arccos(np.clip(centroids[:, 2] / radius, -1.0, 1.0)))
+    azimuth = np.degrees(np.arctan2(centroids[:, 1], centroids[:, 0])) % 360.0
+    out = np.full((len(azimuths), len(polar_angles)), np.nan)
+    for i, phi in enumerate(azimuths):
+        near = np.abs((azimuth - phi + 180.0) % 360.0 - 180.0) < azimuth_width
+        sign = np.sign(np.sin(np.radians(2.0 * phi))) if signed else 1.0
+        for j, theta in enumerate(polar_angles):
+            chosen = near & (np.abs(polar - theta) < polar_width)
+            if chosen.any():
+                out[i, j] = sign * float(np.mean(values[chosen]))
+    return out

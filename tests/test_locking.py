@@ -1,0 +1,155 @@
+"""Node-smoothed yarn stretches (``Problem(yarn_strain="smoothed")``): exact derivatives, the
+patch test, and no intra-ply shear locking of a stiff-yarn ply on a hemisphere."""
+
+import numpy as np
+import pytest
+
+from vares.analysis.locking import solve_yarn_strain
+from vares.geometry.examples import grid_cells, irregular_cap
+from vares.geometry.mesh import SurfaceMesh
+from vares.materials import (
+    Fibres,
+    MaterialError,
+    NeoHooke,
+    NonCrimpFabric,
+    OrthotropicStVenantKirchhoff,
+)
+from vares.mechanics import Assembler
+from vares.mechanics.problem import Problem
+
+LAWS = {
+    "orthotropic": OrthotropicStVenantKirchhoff(100.0, 80.0, 1.0, 0.2),
+    "ncf": NonCrimpFabric.from_moduli(100.0, 80.0, 1.0),
+}
+
+
+def mixed_mesh() -> SurfaceMesh:
+    """A curved sheet of quads and triangles (every third quad split in two)."""
+    n_u, n_v = 6, 5  # nodes j n_u + i
+    v, u = np.meshgrid(np.linspace(0, 0.8, n_v), np.linspace(0, 1, n_u), indexing="ij")
+    points = np.column_stack([u.ravel(), v.ravel(), (0.3 * u**2 - 0.2 * u * v).ravel()])
+    quads = grid_cells(n_u, n_v, "quad")["quad"]
+    split = np.arange(len(quads)) % 3 == 0
+    triangles = np.vstack([quads[split][:, [0, 1, 2]], quads[split][:, [0, 2, 3]]])
+    return SurfaceMesh(points, {"quad": quads[~split], "triangle": triangles})
+
+
+def complex_step_check(problem: Problem, x: np.ndarray, probes: int = 10) -> tuple[float, float]:
+    """Largest relative errors of the assembled gradient (against the complex-step derivative of
+    the energy) and of the Hessian's columns (against that of the gradient)."""
+    n = x.size
+    assembler = Assembler(problem.connectivity, np.ones(n, dtype=bool))
+    evaluation = problem.evaluate(x, order=2)
+    gradient = assembler.vector(evaluation.gradients).ravel()
+    hessian = assembler.matrix(evaluation.hessians).toarray()
+    h = 1e-30
+    gradient_error = hessian_error = 0.0
+    for k in np.random.default_rng(1).choice(n, probes, replace=False):
+        shifted = x.astype(complex)
+        shifted.ravel()[k] += 1j * h
+        at = problem.evaluate(shifted, order=1)
+        energy_slope = sum(np.sum(e).imag for e in at.cell_energy) / h
+        values = np.concatenate([g.ravel() for g in at.gradients])
+        column = np.bincount(assembler._all_dofs, weights=values.imag, minlength=n) / h
+        gradient_error = max(gradient_error, abs(energy_slope - gradient[k]))
+        hessian_error = max(hessian_error, np.abs(column - hessian[:, k]).max())
+    return gradient_error / np.abs(gradient).max(), hessian_error / np.abs(hessian).max()
+
+
+@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("stabilisation", [0.0, 0.3])
+def test_derivatives_against_complex_step(law, stabilisation):
+    mesh = irregular_cap(100.0, 40.0, 4, 0.3, 1)
+    x = 1.02 * mesh.points[:, :2] + np.random.default_rng(0).normal(0, 0.3, (mesh.num_points, 2))
+    problem = Problem(
+        mesh,
+        LAWS[law],
+        1.3,
+        fibres=Fibres.from_angles(17.0),
+        prestress=(0.4, 0.2),
+        yarn_strain="smoothed",
+        yarn_stabilisation=stabilisation,
+    )
+    gradient_error, hessian_error = complex_step_check(problem, x)
+    assert gradient_error < 1e-12
+    assert hessian_error < 1e-12
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_derivatives_on_quads_and_triangles(law):
+    mesh = mixed_mesh()
+    x = mesh.points[:, :2] * [1.05, 0.97] + np.random.default_rng(2).normal(
+        0, 0.01, (mesh.num_points, 2)
+    )
+    problem = Problem(mesh, LAWS[law], fibres=Fibres.from_angles(-30.0), yarn_strain="smoothed")
+    gradient_error, hessian_error = complex_step_check(problem, x)
+    assert gradient_error < 1e-12
+    assert hessian_error < 1e-12
+
+
+def test_projected_hessian_is_positive_semidefinite_and_exact_at_the_solution_state():
+    mesh = irregular_cap(100.0, 40.0, 4, 0.3, 1)
+    x = mesh.points[:, :2] + np.random.default_rng(3).normal(0, 0.5, (mesh.num_points, 2))
+    problem = Problem(mesh, LAWS["ncf"], fibres=Fibres.from_angles(10.0), yarn_strain="smoothed")
+    assembler = Assembler(problem.connectivity, np.ones(x.size, dtype=bool))
+    projected = assembler.matrix(problem.evaluate(x, projected=True).hessians).toarray()
+    assert (
+        np.linalg.eigvalsh(0.5 * (projected + projected.T)).min() > -1e-10 * np.abs(projected).max()
+    )
+
+
+def flat_disk() -> SurfaceMesh:
+    """Irregular triangles on a flat disk of radius about 87 (the plan of a 60° cap)."""
+    cap = irregular_cap(100.0, 60.0, 10, 0.3, 2)
+    points = cap.points.copy()
+    points[:, 2] = 0.0
+    return SurfaceMesh(points, cap.cells)
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_patch_test_uniform_stretch(law):
+    """A uniform stretch has every smoothed stretch equal to every cell's: energy and residual
+    those of the cell-wise law."""
+    mesh = flat_disk()
+    stretch = np.array([[0.97, 0.08], [-0.05, 1.04]])
+    x = mesh.points[:, :2] @ stretch.T
+    kwargs = {"fibres": Fibres.from_angles(25.0), "prestress": (0.3, 0.1)}
+    element = Problem(mesh, LAWS[law], 2.0, **kwargs)
+    smoothed = Problem(mesh, LAWS[law], 2.0, yarn_strain="smoothed", **kwargs)
+    a, b = element.evaluate(x, order=1), smoothed.evaluate(x, order=1)
+    assert b.energy == pytest.approx(a.energy, rel=1e-12)
+    ga = Assembler(element.connectivity, np.ones(x.size, bool)).vector(a.gradients)
+    gb = Assembler(smoothed.connectivity, np.ones(x.size, bool)).vector(b.gradients)
+    assert np.abs(gb - ga).max() < 1e-10 * np.abs(ga).max()
+
+
+def test_patch_test_prestressed_disk_solves_to_a_uniform_stretch():
+    """A flat disk under a yarn prestress shrinks uniformly: the pattern is an affine image of
+    the disk, the same with smoothed yarn stretches as cell by cell."""
+    mesh = flat_disk()
+    law = LAWS["orthotropic"]
+    patterns = []
+    for yarn_strain in ("element", "smoothed"):
+        result = solve_yarn_strain(
+            mesh,
+            law,
+            prestress=(2.0, 1.0),
+            yarn_strain=yarn_strain,
+            initial_guess=mesh.points[:, :2],
+        )
+        assert result.converged
+        patterns.append(result.coordinates)
+    plane = np.column_stack([mesh.points[:, :2], np.ones(mesh.num_points)])
+    for pattern in patterns:
+        affine, *_ = np.linalg.lstsq(plane, pattern, rcond=None)
+        assert np.abs(plane @ affine - pattern).max() < 1e-9 * 87.0
+        assert abs(np.linalg.det(affine[:2]) - 1.0) > 1e-3  # a real stretch, not the disk
+    assert np.abs(patterns[1] - patterns[0]).max() < 1e-9 * 87.0
+
+
+def test_unsupported_settings_are_refused():
+    mesh = irregular_cap(100.0, 40.0, 3, 0.3, 1)
+    with pytest.raises(ValueError, match="yarn_strain"):
+        Problem(mesh, LAWS["ncf"], fibres=Fibres.from_angles(0.0), yarn_strain="nodal")
+    with pytest.raises(MaterialError, match="I4, I6, I8"):
+        Problem(mesh, NeoHooke(1.0, 0.3), fibres=Fibres.from_angles(0.0), yarn_strain="smoothed")
