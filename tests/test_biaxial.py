@@ -330,6 +330,7 @@ def test_fabric_fit_then_pattern_with_the_fabric_file(tmp_path):
     assert result.exit_code == 0, result.stderr
     report = (out / "report.html").read_text(encoding="utf-8")
     assert "measured compensation at 2 / 1.5" in report and "msaj-1.csv" in report
+    assert measured.specimens == 2 and "% (mean ± std)" in report
     summary = json.loads((out / "summary.json").read_text())
     warp = summary["compensation"]["warp"]["compensation_mean"]
     assert warp == pytest.approx(100 * measured.warp / (1 + measured.warp), rel=0.02)
@@ -440,6 +441,10 @@ def test_fabric_band_needs_the_scatter_of_the_compensation_values(tmp_path):
     refused = run("fabric", "band", "--example", "hypar", "--fabric", single)
     assert refused.exit_code == 2, refused.stderr
     assert "no scatter" in error_line(refused) and "1 specimen" in error_line(refused)
+    out = tmp_path / "hypar"
+    flags = ("--prestress", "2,1.5", "--report", "-q")
+    assert run("example", "hypar", "-o", out, "--fabric", single, *flags).exit_code == 0
+    assert "% (one specimen: no scatter)" in (out / "report.html").read_text(encoding="utf-8")
 
 
 def test_fabric_file_strings_read_back_as_they_were():

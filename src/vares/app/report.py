@@ -98,7 +98,8 @@ def _fabric_file_rows(job: Job) -> list[tuple[str, object]]:
             (
                 f"measured compensation at {number(c.prestress[0])} / {number(c.prestress[1])}",
                 f"warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, "
-                f"fill {100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % (mean ± std)",
+                f"fill {100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % "
+                + ("(one specimen: no scatter)" if c.specimens == 1 else "(mean ± std)"),
             )
         )
     return rows
