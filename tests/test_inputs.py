@@ -460,3 +460,12 @@ def test_a_soup_knows_which_file_face_each_of_its_cells_is(tmp_path):
     np.testing.assert_array_equal(soup.order, [1, 3, 0, 2])
     np.testing.assert_array_equal(soup.cells["triangle"], [faces[1], faces[3]])
     np.testing.assert_array_equal(soup.cells["quad"], [faces[0]])
+
+
+@pytest.mark.parametrize("face", ["f 0 3 4", "f 1/1 3/1 0/1"])
+def test_an_obj_face_with_vertex_index_zero_says_so(tmp_path, face):
+    # OBJ counts from 1: index 0 was taken as the vertex after the last ("vertex 5 of 4")
+    path = tmp_path / "zero.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\n" + face + "\n")
+    with pytest.raises(MeshError, match=r"line 6: vertex index 0 .*OBJ counts vertices from 1"):
+        read_mesh_file(path)

@@ -103,6 +103,11 @@ def read_obj(path: Path) -> PolygonSoup:
                     f"got {line.strip()!r}"
                 )
             indices = _numbers([t.split("/")[0] for t in tokens[1:]], path, number, int)
+            if 0 in indices:
+                raise MeshError(
+                    f"{path}, line {number}: vertex index 0 in {line.strip()!r}: OBJ counts "
+                    "vertices from 1 (or back from -1)"
+                )
             # 1-based; negative counts back from the vertices read so far
             faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
     return _soup(points, faces, path)
