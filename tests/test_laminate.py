@@ -304,3 +304,35 @@ def test_the_shipped_example(tmp_path):
         drape = result.drape(name)
         np.testing.assert_allclose(ply.warp, drape.warp[ply.elements - 1], rtol=0, atol=1e-9)
         np.testing.assert_allclose(ply.fill, drape.fill[ply.elements - 1], rtol=0, atol=1e-9)
+
+
+def test_a_job_takes_a_region_from_the_moulds_cell_data(tmp_path):
+    mesh = mould()
+    centroids = mesh.points[mesh.cells["triangle"]].mean(axis=1)
+    zone = np.where(centroids[:, 0] > 1.0, 2.0, 1.0)
+    write_surface(tmp_path / "mould.vtu", mesh, None, {"zone": zone})
+    text = job_text((0.0, 90.0)).replace('"mould.obj"', '"mould.vtu"')
+    text = text.replace(
+        'name = "P2"', 'name = "P2"\nregion = "zone"\nregion_value = 2.0\ndrop_off = 1'
+    )
+    (tmp_path / "job.toml").write_text(text)
+    result = run_laminate(load_laminate_job(tmp_path / "job.toml"), workers=1)
+    patch = result.drape("P2")
+    assert result.converged
+    np.testing.assert_array_equal(patch.cells, np.flatnonzero(zone == 2.0))
+    # the seed is the region's node nearest the region's centroid (the mould's top is outside)
+    region = mesh.points[patch.nodes]
+    assert np.linalg.norm(region - patch.seed, axis=1).min() == 0.0
+    nearest = region[np.argmin(np.linalg.norm(region - region.mean(axis=0), axis=1))]
+    np.testing.assert_array_equal(patch.seed, nearest)
+    assert (
+        patch.kinematic is not None and np.isfinite(patch.kinematic_shear_angle[patch.cells]).all()
+    )
+    assert not result.pairs["0°", "90°"].checked
+    assert np.isnan(result.pair_matrix("warp_compressed_fraction")[0, 1])
+    data = meshio.read(tmp_path / "out" / "laminate.vtu").cell_data
+    assert np.isnan(data["P2_warp"][0][zone == 1.0]).all()
+    table = read_abaqus_orientations(tmp_path / "out" / "orientations.inp")["P2"]
+    np.testing.assert_array_equal(table.elements, np.flatnonzero(zone == 2.0) + 1)
+    summary = json.loads((tmp_path / "out" / "laminate.json").read_text())
+    assert summary["plies"][1]["drop_off"] == 1 and summary["plies"][1]["region"] == "zone"

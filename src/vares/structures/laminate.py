@@ -327,16 +327,22 @@ def _region_cells(ply: PlyOptions, cell_data: Mapping[str, np.ndarray], num_cell
     return cells
 
 
-def _submesh(mesh: SurfaceMesh, cells: np.ndarray) -> tuple[SurfaceMesh, np.ndarray]:
-    """The mesh of the given global cells and its nodes' indices on ``mesh``."""
-    if len(cells) == mesh.num_cells:
-        return mesh, np.arange(mesh.num_points)
+def _blocks(mesh: SurfaceMesh, cells: np.ndarray) -> dict[str, np.ndarray]:
+    """The node indices of the given global cells, by cell type."""
     blocks, start = {}, 0
     for cell_type, block in mesh.cells.items():
         mine = cells[(cells >= start) & (cells < start + len(block))] - start
         if mine.size:
             blocks[cell_type] = block[mine]
         start += len(block)
+    return blocks
+
+
+def _submesh(mesh: SurfaceMesh, cells: np.ndarray) -> tuple[SurfaceMesh, np.ndarray]:
+    """The mesh of the given global cells and its nodes' indices on ``mesh``."""
+    if len(cells) == mesh.num_cells:
+        return mesh, np.arange(mesh.num_points)
+    blocks = _blocks(mesh, cells)
     nodes = np.unique(np.concatenate([b.ravel() for b in blocks.values()]))
     index = np.full(mesh.num_points, -1)
     index[nodes] = np.arange(len(nodes))
@@ -426,8 +432,16 @@ def drape_laminate(
     ply_drape: dict[str, tuple] = {}
     for ply in laminate.plies:
         o = ply.options
-        seed = np.asarray(o.seed, dtype=float) if o.seed is not None else default_seed
         cells = _region_cells(o, cell_data, mesh.num_cells)
+        if o.seed is not None:
+            seed = np.asarray(o.seed, dtype=float)
+        elif len(cells) < mesh.num_cells:
+            blocks = _blocks(mesh, cells).values()
+            region = points[np.unique(np.concatenate([b.ravel() for b in blocks]))]
+            target = region.mean(axis=0) if options.seed is None else default_seed
+            seed = region[np.argmin(np.linalg.norm(region - target, axis=1))]
+        else:
+            seed = default_seed
         key = _key(ply, seed, cells)
         ply_drape[o.name] = key
         if key in groups:

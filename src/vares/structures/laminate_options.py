@@ -107,7 +107,12 @@ class PlyOptions(Options):
         choices=tuple(FABRIC_KINDS),
     )
     seed: tuple[float, float, float] | None = option(
-        None, "vector", "Seed point 'x,y,z' (default: the laminate's).", section="ply"
+        None,
+        "vector",
+        "Seed point 'x,y,z' (default: the laminate's; for a ply with a region, the region's node "
+        "nearest the laminate's seed, or without one the region's node nearest its nodes' "
+        "centroid).",
+        section="ply",
     )
     region: str | None = option(
         None,
