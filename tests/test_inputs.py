@@ -462,10 +462,17 @@ def test_a_soup_knows_which_file_face_each_of_its_cells_is(tmp_path):
     np.testing.assert_array_equal(soup.cells["quad"], [faces[0]])
 
 
-@pytest.mark.parametrize("face", ["f 0 3 4", "f 1/1 3/1 0/1"])
-def test_an_obj_face_with_vertex_index_zero_says_so(tmp_path, face):
-    # OBJ counts from 1: index 0 was taken as the vertex after the last ("vertex 5 of 4")
+@pytest.mark.parametrize(
+    ("face", "message"),
+    [
+        ("f 0 3 4", r"line 6: vertex index 0 .*OBJ counts vertices from 1"),
+        ("f 1/1 3/1 0/1", r"line 6: vertex index 0 .*OBJ counts vertices from 1"),
+        ("f -10 3 4", r"line 6: vertex index -10 counts back past the first vertex \(4 read"),
+    ],
+)
+def test_an_obj_face_index_out_of_range_is_named_as_written(tmp_path, face, message):
+    # index 0 was taken as the vertex after the last ("vertex 5 of 4"), -10 of 4 as "vertex -6"
     path = tmp_path / "zero.obj"
     path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\n" + face + "\n")
-    with pytest.raises(MeshError, match=r"line 6: vertex index 0 .*OBJ counts vertices from 1"):
+    with pytest.raises(MeshError, match=message):
         read_mesh_file(path)

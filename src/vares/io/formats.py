@@ -108,6 +108,12 @@ def read_obj(path: Path) -> PolygonSoup:
                     f"{path}, line {number}: vertex index 0 in {line.strip()!r}: OBJ counts "
                     "vertices from 1 (or back from -1)"
                 )
+            behind = [i for i in indices if i < -len(points)]
+            if behind:
+                raise MeshError(
+                    f"{path}, line {number}: vertex index {behind[0]} counts back past the "
+                    f"first vertex ({len(points)} read so far)"
+                )
             # 1-based; negative counts back from the vertices read so far
             faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
     return _soup(points, faces, path)
