@@ -102,6 +102,8 @@ def test_job_refuses_bad_plies():
         parse(job_text().replace('name = "P3"', 'name = "P3"\nregion_value = 2.0'))
     with pytest.raises(JobError, match=r"\[structure\] is not for a laminate"):
         parse(job_text(extra="[structure]\n"))
+    with pytest.raises(JobError, match=r"\[output\] report is not used by a laminate job"):
+        parse(job_text().replace('directory = "out"', 'directory = "out"\nreport = true'))
 
 
 def test_laminate_refuses_repeated_names_and_drop_offs():

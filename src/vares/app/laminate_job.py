@@ -33,7 +33,8 @@ materials::
     drop_off = 1
 
 Every table and key is checked against its options class; an unknown one is an error naming the
-closest valid spelling. ``[fibres] warp_direction`` is refused: each ply's orientation sets it.
+closest valid spelling. ``[fibres] warp_direction`` is refused (each ply's orientation sets it),
+as are the tables and keys a laminate job does not use (``[prestress]``, ``[output] report``, …).
 """
 
 from __future__ import annotations
@@ -56,6 +57,19 @@ __all__ = ["LAMINATE_TABLES", "LaminateJob", "load_laminate_job"]
 LAMINATE_TABLES = ("laminate", "ply", "materials")
 #: Tables of a job that a laminate job does not take.
 _REFUSED = ("structure", "cut", "erection", "drape", "prestress")
+#: Keys of a job's tables that a laminate job does not use.
+_UNUSED = {
+    "input": ("initial_pattern", "name", "panel_field"),
+    "output": (
+        "report",
+        "dxf_units",
+        "allowance",
+        "mark_spacing",
+        "allow_overlap",
+        "previews",
+        "plots",
+    ),
+}
 
 
 @dataclass(frozen=True)
@@ -82,6 +96,11 @@ class LaminateJob:
                 raise JobError(f"{origin}: unknown table [{section}]{hint}")
             if section in _REFUSED:
                 raise JobError(f"{origin}: [{section}] is not for a laminate job")
+        for section, keys in _UNUSED.items():
+            values = data.get(section)
+            used = [k for k in keys if isinstance(values, dict) and k in values]
+            if used:
+                raise JobError(f"{origin}: [{section}] {used[0]} is not used by a laminate job")
         rest = {k: v for k, v in data.items() if k not in LAMINATE_TABLES}
         job = Job.from_dict(rest, origin, base)
         if job.solve.warp_direction is not None:
