@@ -11,9 +11,11 @@ tried too, and does not fit.
 A line is every piece of the plane section of its parameter (a plane near a sagging edge cuts the
 surface twice: the corner beyond it is a strip of its own), or the geodesic between the ends of
 that piece. The pieces a gap between two lines leaves are its strips, and the gap is as wide as
-the widest of them. A geodesic that comes closer to the next line's plane than
-``1 − STRAY`` of the way, or touches the boundary between its ends (a geodesic hugs a sagging
-edge), is replaced by its plane section: plane sections of different parameters never meet.
+the widest of them. A geodesic that touches the boundary between its ends (a geodesic hugs a
+sagging edge), or comes closer to a line of the neighbouring parameter than ``APART`` × their
+parameters' difference (compared at the same coordinate along the strips), is replaced by its
+plane section, and so on until all lines keep apart: plane sections of different parameters
+never meet.
 
 A design mesh is often coarser than the strips: the surface is refined on its own faces first
 (:mod:`vares.geometry.refine`) until no edge is longer than the roll width / ``CELLS_ACROSS``;
@@ -41,9 +43,9 @@ from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
 from .panels import Panel, split_panels, width_across_warp
 
 __all__ = [
+    "APART",
     "CELLS_ACROSS",
     "SEAM_KINDS",
-    "STRAY",
     "StripPlan",
     "pattern_direction",
     "plan_strips",
@@ -55,8 +57,8 @@ SEAM_KINDS = ("geodesic", "planar")
 _EQUALISE, _EQUAL = 6, 1.005
 #: Cells across a strip of roll width at least (by their longest edges; module docs).
 CELLS_ACROSS = 2
-#: How far a geodesic may stray from its plane: this fraction of the way to the next line's.
-STRAY = 0.4
+#: Neighbouring lines stay at least this fraction of their parameters' difference apart.
+APART = 0.2
 #: Pieces of a plane section shorter than this fraction of the roll width are no cutting lines.
 _SHORTEST = 0.1
 #: Further refinements at most, when planned lines meet, before plane sections replace geodesics.
@@ -240,15 +242,8 @@ def _layout(surface, family, spans, seams, snap, warp_direction, width) -> Strip
                 where.append(index)
     base, lines, replaced = surface, sections, 0
     if seams == "geodesic" and sections:
-        base, geodesics = geodesic_between_ends(surface, sections, snap)
-        lines, room, boundary = [], _room(family, bounds), _boundary(base)
-        for section, geodesic, index in zip(sections, geodesics, where, strict=True):
-            s, (below, above) = bounds[index], room[index]
-            if _touches(geodesic, boundary) or _strays(geodesic, family, s, below, above):
-                lines.append(_same_section(family, base, s, section))
-                replaced += 1
-            else:
-                lines.append(geodesic)
+        base, lines = geodesic_between_ends(surface, sections, snap)
+        replaced = _keep_apart(family, base, bounds, sections, lines, where)
     plan = strips_along_lines(base, lines, snap, warp_direction, family)
     plan.replaced_geodesics = replaced
     return plan
@@ -267,33 +262,61 @@ def _same_section(
     return min(family.sections(mesh, s), key=distance)
 
 
-def _room(family: LineFamily, bounds: np.ndarray) -> list[tuple[float, float]]:
-    """How far (in the parameter) each line may stray below and above its own: ``STRAY`` of
-    the way to the neighbouring lines (unbounded towards the surface's edge)."""
+def _keep_apart(family, base, bounds, sections, lines, where) -> int:
+    """Replace by its plane section (in ``lines``, in place) every geodesic that touches the
+    boundary between its ends, or that comes closer to a line of a neighbouring parameter than
+    ``APART`` × their parameters' difference; the number replaced."""
     period = family.span[1] - family.span[0]
-    if family.closed:
-        below = np.diff(np.concatenate([[bounds[-1] - period], bounds]))
-        above = np.diff(np.concatenate([bounds, [bounds[0] + period]]))
-    else:
-        gaps = np.diff(bounds)
-        below = np.concatenate([[np.inf], gaps])
-        above = np.concatenate([gaps, [np.inf]])
-    return list(zip((STRAY * below).tolist(), (STRAY * above).tolist(), strict=True))
+    own = [float(bounds[k]) for k in where]
+    boundary = _boundary(base)
+    geodesic = [not _touches(line, boundary) for line in lines]
+    last = len(bounds) - 1
+    pairs = []
+    for i, j in itertools.permutations(range(len(lines)), 2):
+        if where[j] == where[i] + 1:
+            pairs.append((i, j, own[j]))
+        elif family.closed and last > 0 and where[i] == last and where[j] == 0:
+            pairs.append((i, j, own[j] + period))
+    replace = [k for k in range(len(lines)) if not geodesic[k]]
+    while replace:
+        for k in replace:
+            lines[k], geodesic[k] = _same_section(family, base, own[k], sections[k]), False
+        replace = []
+        for i, j, above in pairs:
+            if (geodesic[i] or geodesic[j]) and _too_close(
+                family, lines[i], own[i], lines[j], above
+            ):
+                replace += [k for k in (i, j) if geodesic[k] and k not in replace]
+    return geodesic.count(False)
 
 
-def _strays(line: SurfaceLine, family: LineFamily, s: float, below: float, above: float) -> bool:
-    """Whether a line's points between its ends leave the parameters ``[s − below, s + above]``
-    (points on the axis of a radial family, where every line passes, do not count)."""
-    inner = line.points[1:-1]
+def _chart(family: LineFamily, line: SurfaceLine, s: float) -> tuple[np.ndarray, np.ndarray]:
+    """A line's points as (along, parameter), the parameter continued from ``s`` (points on the
+    axis of a radial family, where every line passes, left out), sorted along."""
+    points = line.points
     if family.kind == "radial":
-        radius = np.hypot(inner[:, 0] - family.centre[0], inner[:, 1] - family.centre[1])
-        inner = inner[radius > 1e-9 * radius.max(initial=0.0)]
-    if not len(inner):
-        return False
-    offset = family.parameter(inner) - s
+        radius = np.hypot(points[:, 0] - family.centre[0], points[:, 1] - family.centre[1])
+        points = points[radius > 1e-9 * radius.max(initial=0.0)]
+    along, offset = family.along(points), family.parameter(points) - s
     if family.kind == "radial":
         offset = np.mod(offset + np.pi, 2 * np.pi) - np.pi
-    return bool(offset.min() < -below or offset.max() > above)
+    order = np.argsort(along)
+    return along[order], s + offset[order]
+
+
+def _too_close(family, first: SurfaceLine, s: float, second: SurfaceLine, t: float) -> bool:
+    """Whether two lines of parameters ``s < t`` come closer than ``APART`` × (t − s) in the
+    parameter, where both run (compared at the same coordinates along the strips)."""
+    along_1, p_1 = _chart(family, first, s)
+    along_2, p_2 = _chart(family, second, t)
+    if not (len(along_1) and len(along_2)):
+        return False
+    low, high = max(along_1[0], along_2[0]), min(along_1[-1], along_2[-1])
+    if not high > low:
+        return False
+    where = np.linspace(low, high, 65)
+    gap = np.interp(where, along_2, p_2) - np.interp(where, along_1, p_1)
+    return bool(gap.min() < APART * (t - s))
 
 
 def _boundary(mesh: SurfaceMesh) -> tuple[set[int], set[tuple[int, int]]]:
