@@ -338,3 +338,22 @@ def test_a_job_takes_a_region_from_the_moulds_cell_data(tmp_path):
     np.testing.assert_array_equal(table.elements, np.flatnonzero(zone == 2.0) + 1)
     summary = json.loads((tmp_path / "out" / "laminate.json").read_text())
     assert summary["plies"][1]["drop_off"] == 1 and summary["plies"][1]["region"] == "zone"
+
+
+def test_the_table_can_hold_the_kinematic_directions(written, tmp_path):
+    from dataclasses import replace
+
+    from vares.io.orientations import write_abaqus_orientations
+
+    result, _ = written
+    options = result.laminate.options.replace(fe_directions="kinematic")
+    kinematic = replace(result, laminate=replace(result.laminate, options=options))
+    write_abaqus_orientations(tmp_path / "k.inp", orientation_tables(kinematic))
+    for name, ply in read_abaqus_orientations(tmp_path / "k.inp").items():
+        drape = result.drape(name)
+        rows = ply.elements - 1
+        assert len(rows) > 0.9 * result.mesh.num_cells
+        np.testing.assert_allclose(ply.warp, drape.kinematic_warp[rows], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(ply.fill, drape.kinematic_fill[rows], rtol=0, atol=1e-9)
+    with pytest.raises(OptionsError, match="fe_directions"):
+        options.replace(kinematic=False)

@@ -12,7 +12,8 @@ Into the job's output folder (replaced as a whole when the run succeeds, see
   ``<ply>_kinematic_shear_angle``; NaN outside a ply's region;
 - ``orientations.inp``: the Abaqus orientation table, one ``*ORIENTATION`` per ply
   (:mod:`vares.io.orientations`); ``orientations.csv``: the same directions with element ids and
-  the shear angle;
+  the shear angle (those of the mechanical drape, or of the kinematic net with
+  ``fe_directions = "kinematic"``);
 - ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields.
 """
 
@@ -68,19 +69,27 @@ def file_label(label: str) -> str:
 
 
 def orientation_tables(result: LaminateResult) -> list[PlyOrientations]:
-    """Per ply (bottom first) its elements (labels from 1), draped warp, fill and shear."""
+    """Per ply (bottom first) its elements (labels from 1), draped warp, fill and shear: of the
+    mechanical drape, or of the kinematic net with ``fe_directions = "kinematic"`` (then only
+    the elements the net reaches)."""
+    kinematic = result.laminate.options.fe_directions == "kinematic"
     tables = []
     for ply in result.laminate.plies:
         drape = result.drape(ply.name)
-        cells = drape.cells
+        if kinematic:
+            warp, fill = drape.kinematic_warp, drape.kinematic_fill
+            shear = drape.kinematic_shear_angle
+        else:
+            warp, fill, shear = drape.warp, drape.fill, drape.shear_angle
+        cells = drape.cells[np.isfinite(warp[drape.cells]).all(axis=1)]
         default_fill = np.cross(drape.normal, drape.warp_direction)
         tables.append(
             PlyOrientations(
                 ply.name,
                 cells + 1,
-                drape.warp[cells],
-                drape.fill[cells],
-                drape.shear_angle[cells],
+                warp[cells],
+                fill[cells],
+                shear[cells],
                 drape.warp_direction,
                 default_fill / np.linalg.norm(default_fill),
             )

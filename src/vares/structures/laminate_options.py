@@ -55,6 +55,14 @@ class LaminateOptions(Options):
         section="laminate",
         flags=("--kinematic/--no-kinematic",),
     )
+    fe_directions: str = option(
+        "mechanical",
+        "str",
+        "The yarn directions written for FE (orientations.inp, orientations.csv): those of the "
+        "mechanical drape, or of the kinematic net (only the cells it reaches).",
+        section="laminate",
+        choices=("mechanical", "kinematic"),
+    )
     compression_strain: float = option(
         1e-3,
         "float",
@@ -71,6 +79,10 @@ class LaminateOptions(Options):
         section="laminate",
         positive=True,
     )
+
+    def check(self) -> None:
+        if self.fe_directions == "kinematic" and not self.kinematic:
+            raise OptionsError("fe_directions", "'kinematic' needs kinematic = true")
 
 
 @dataclass(frozen=True)
