@@ -338,6 +338,7 @@ def test_a_job_takes_a_region_from_the_moulds_cell_data(tmp_path):
     np.testing.assert_array_equal(table.elements, np.flatnonzero(zone == 2.0) + 1)
     summary = json.loads((tmp_path / "out" / "laminate.json").read_text())
     assert summary["plies"][1]["drop_off"] == 1 and summary["plies"][1]["region"] == "zone"
+    assert summary["pairs"]["warp_compressed_fraction"][0][1] is None
 
 
 def test_the_table_can_hold_the_kinematic_directions(written, tmp_path):

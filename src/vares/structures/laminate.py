@@ -283,7 +283,7 @@ class LaminateResult:
         return np.array([[getattr(self.pairs[a, b], value) for b in labels] for a in labels])
 
     def summary(self) -> dict[str, Any]:
-        """The numbers for ``laminate.json``."""
+        """The numbers for ``laminate.json`` (a pair not checked is ``None`` in the matrices)."""
         plies = []
         for ply in self.laminate.plies:
             o = ply.options
@@ -307,8 +307,13 @@ class LaminateResult:
             "plies": plies,
             "drapes": [d.summary() for d in self.drapes],
             "pair_labels": self.labels,
-            "pairs": {v: self.pair_matrix(v).tolist() for v in PAIR_VALUES},
+            "pairs": {v: _listed(self.pair_matrix(v)) for v in PAIR_VALUES},
         }
+
+
+def _listed(matrix: np.ndarray) -> list[list[float | None]]:
+    """A matrix as nested lists, NaN (a pair not checked) as ``None`` (JSON's null)."""
+    return [[float(v) if np.isfinite(v) else None for v in row] for row in matrix]
 
 
 def _region_cells(ply: PlyOptions, cell_data: Mapping[str, np.ndarray], num_cells: int):
