@@ -508,3 +508,17 @@ def test_pattern_job_drapes_a_ply_beside_the_pattern(tmp_path):
     )
     refused = run("run", structure, "-o", tmp_path / "refused")
     assert refused.exit_code == 2 and "single surface" in error_line(refused)
+
+
+def test_a_drape_beside_a_pattern_lays_the_ply_as_the_patterns_warp_runs(tmp_path):
+    """A pattern whose warp is given in the pattern frame (45°), draped beside it: the net is laid
+    along where the pattern's warp runs on the surface, so its shear follows the pattern's
+    (with the warp assumed along x, the two fields were unrelated: correlation 0.04)."""
+    from conftest import run
+
+    result = run("example", "sail", "-o", tmp_path / "s", "--drape", "--warp-angle", "45", "-q")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "s" / "summary.json").read_text())["kinematic_drape"]
+    warp = np.array(summary["warp"])
+    assert abs(abs(warp[0]) - np.sqrt(0.5)) < 0.05 and abs(abs(warp[1]) - np.sqrt(0.5)) < 0.05
+    assert summary["against_pattern"]["correlation"] > 0.8

@@ -356,8 +356,12 @@ def _solve_one(job, source: Input, material, options, callback) -> JobOutcome:
     patterned = _panel(job, source, panel.name, panel.mesh, result)
     if job.drape is not None:
         from ..analysis.drape import drape_ply
+        from ..geometry.orientation import erected_warp
 
-        warp = job.solve.warp_direction or (1.0, 0.0, 0.0)
+        # the ply laid as the pattern's warp runs: the direction asked for, or where it went
+        warp = job.solve.warp_direction
+        if warp is None:
+            warp = tuple(erected_warp(panel.mesh, result.material_coordinates, result.fibres.warp))
         patterned.drape = drape_ply(panel.mesh, job.drape, warp_direction=warp)
     return JobOutcome(job, material, [patterned], units=source.units, repairs=source.repairs)
 

@@ -13,7 +13,7 @@ import numpy as np
 from .elements import ELEMENTS, inverse
 from .mesh import SurfaceMesh
 
-__all__ = ["warp_deviation"]
+__all__ = ["erected_warp", "warp_deviation"]
 
 #: Points where the prescribed direction is within this angle (rad) of the normal are skipped.
 _MIN_TANGENTIAL = 1e-3
@@ -72,3 +72,18 @@ def warp_deviation(
     if total_weight == 0.0:
         raise ValueError("the warp direction is normal to the surface everywhere")
     return total_angle / total_weight, np.concatenate(per_cell)
+
+
+def erected_warp(mesh: SurfaceMesh, coordinates: np.ndarray, warp: np.ndarray) -> np.ndarray:
+    """The 3D-area-weighted mean direction ``(3,)`` (unit) of a pattern's erected warp
+    ``F Φ₁ / |F Φ₁|`` over the surface (``warp`` ``(2,)`` in the pattern plane)."""
+    total = np.zeros(3)
+    for cell_type, cells in mesh.cells.items():
+        element = ELEMENTS[cell_type]
+        j = element.jacobians(mesh.points, cells)  # (m, q, 3, 2)
+        J = element.jacobians(coordinates, cells)  # (m, q, 2, 2)
+        erected = np.einsum("mqik,mqkl,l->mqi", j, inverse(J), np.asarray(warp, dtype=float))
+        erected /= np.linalg.norm(erected, axis=-1, keepdims=True)
+        area = np.linalg.norm(np.cross(j[..., 0], j[..., 1]), axis=-1)
+        total += np.einsum("mq,q,mqi->i", area, element.quadrature_weights, erected)
+    return total / np.linalg.norm(total)
