@@ -19,7 +19,14 @@ from scipy.sparse.csgraph import connected_components
 
 from .elements import ELEMENTS
 
-__all__ = ["MeshError", "SurfaceMesh", "connected_pieces", "corner_fans", "index_listing"]
+__all__ = [
+    "EdgeTable",
+    "MeshError",
+    "SurfaceMesh",
+    "connected_pieces",
+    "corner_fans",
+    "index_listing",
+]
 
 
 class MeshError(ValueError):
@@ -127,7 +134,7 @@ class SurfaceMesh:
         self._points = points
         self._cells = clean
         self._node_map = node_map
-        self._edges: _EdgeTable | None = None
+        self._edges: EdgeTable | None = None
         self._areas: np.ndarray | None = None
         for arr in (self._points, self._node_map, *self._cells.values()):
             arr.setflags(write=False)
@@ -240,10 +247,10 @@ class SurfaceMesh:
                 parts.append(f"{t} cells {index_listing(np.unique(mine))}")
         return "; ".join(parts)
 
-    def _edge_table(self) -> _EdgeTable:
+    def _edge_table(self) -> EdgeTable:
         """The edge table (computed once: the mesh does not change)."""
         if self._edges is None:
-            self._edges = _EdgeTable.of_cells(self._cells, self.num_points)
+            self._edges = EdgeTable.of_cells(self._cells, self.num_points)
         return self._edges
 
     def _validate(self) -> None:
@@ -312,7 +319,7 @@ class SurfaceMesh:
 
         self._check_manifold_vertices(table)
 
-    def _check_manifold_vertices(self, table: _EdgeTable) -> None:
+    def _check_manifold_vertices(self, table: EdgeTable) -> None:
         """Around each node the cells must form a single fan (no 'bow-tie' nodes)."""
         corner_node, fan = corner_fans(
             self.num_points, table.directed, table.owner, table.edge_id, table.order
@@ -366,7 +373,7 @@ def corner_fans(
 
 
 @dataclass(frozen=True)
-class _EdgeTable:
+class EdgeTable:
     """Every directed cell edge, the cell it belongs to, the id of its undirected edge, the
     number of cells at each undirected edge, and the stable order that sorts by edge id."""
 
@@ -377,12 +384,12 @@ class _EdgeTable:
     order: np.ndarray
 
     @classmethod
-    def of_cells(cls, cells: Mapping[str, np.ndarray], num_points: int) -> _EdgeTable:
+    def of_cells(cls, cells: Mapping[str, np.ndarray], num_points: int) -> EdgeTable:
         """The table of cell blocks by type (global cell order: block after block)."""
         return cls.of(directed_edges(cells), num_points)
 
     @classmethod
-    def of(cls, edges: tuple[np.ndarray, np.ndarray], num_points: int) -> _EdgeTable:
+    def of(cls, edges: tuple[np.ndarray, np.ndarray], num_points: int) -> EdgeTable:
         directed, owner = edges
         key = np.minimum(directed[:, 0], directed[:, 1]) * num_points + np.maximum(
             directed[:, 0], directed[:, 1]
@@ -421,7 +428,7 @@ def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.
     """The piece (0, 1, …) of every cell (global cell order): cells are in one piece when a
     chain of shared edges joins them; the largest piece is 0."""
     offset = sum(len(block) for block in cells.values())
-    table = _EdgeTable.of_cells(cells, len(points))
+    table = EdgeTable.of_cells(cells, len(points))
     first, second = table.pairs()
     adjacency = sp.coo_matrix(
         (np.ones(first.size), (table.owner[first], table.owner[second])), shape=(offset, offset)

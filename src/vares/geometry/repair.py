@@ -27,7 +27,7 @@ from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from .elements import ELEMENTS
-from .mesh import MeshError, _EdgeTable, corner_fans, index_listing
+from .mesh import MeshError, EdgeTable, corner_fans, index_listing
 from .weld import coincident_nodes
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
@@ -204,7 +204,7 @@ def _flat_on_boundary(points: np.ndarray, blocks: dict[str, np.ndarray]) -> dict
     }
     if not any(mask.any() for mask in flat.values()):
         return flat
-    table = _EdgeTable.of_cells(blocks, len(points))
+    table = EdgeTable.of_cells(blocks, len(points))
     at_boundary = np.zeros(sum(len(b) for b in blocks.values()), dtype=bool)
     at_boundary[table.owner[table.counts[table.edge_id] == 1]] = True
     start = 0
@@ -221,7 +221,7 @@ def _orient(blocks: dict[str, np.ndarray], num_points: int) -> tuple[dict[str, n
     total = sum(len(b) for b in blocks.values())
     if not total:
         return blocks, 0
-    table = _EdgeTable.of_cells(blocks, num_points)
+    table = EdgeTable.of_cells(blocks, num_points)
     directed, owner, counts = table.directed, table.owner, table.counts
     a, b = table.pairs()
     manifold = counts[table.edge_id[a]] == 2
@@ -260,7 +260,7 @@ def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
     names = list(blocks)
     if not sum(len(b) for b in blocks.values()):
         return points, blocks, 0
-    table = _EdgeTable.of_cells(blocks, len(points))
+    table = EdgeTable.of_cells(blocks, len(points))
     # the block, row and column (corner) of every directed edge's start, in the table's order
     offsets = np.cumsum([0, *(len(b) for b in blocks.values())])
     block_of = np.concatenate([np.full(b.size, k) for k, b in enumerate(blocks.values())])
