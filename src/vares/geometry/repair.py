@@ -27,7 +27,7 @@ from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from .elements import ELEMENTS
-from .mesh import MeshError, EdgeTable, corner_fans, index_listing
+from .mesh import EdgeTable, MeshError, corner_fans, index_listing
 from .weld import coincident_nodes
 
 __all__ = ["WELD_TOLERANCE", "RepairReport", "Repaired", "repair", "triangulate_polygon"]
