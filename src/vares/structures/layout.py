@@ -278,7 +278,7 @@ def _keep_apart(family, base, bounds, sections, lines, where) -> int:
         elif family.closed and last > 0 and where[i] == last and where[j] == 0:
             pairs.append((i, j, own[j] + period))
     replace = [k for k in range(len(lines)) if not geodesic[k]]
-    while replace:
+    while True:
         for k in replace:
             lines[k], geodesic[k] = _same_section(family, base, own[k], sections[k]), False
         replace = []
@@ -287,7 +287,8 @@ def _keep_apart(family, base, bounds, sections, lines, where) -> int:
                 family, lines[i], own[i], lines[j], above
             ):
                 replace += [k for k in (i, j) if geodesic[k] and k not in replace]
-    return geodesic.count(False)
+        if not replace:
+            return geodesic.count(False)
 
 
 def _chart(family: LineFamily, line: SurfaceLine, s: float) -> tuple[np.ndarray, np.ndarray]:
