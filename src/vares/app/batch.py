@@ -13,11 +13,11 @@ import json
 import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import asdict, dataclass
-from multiprocessing import get_context
 from pathlib import Path
 
+from ..parallel import process_pool
 from .job import Job, JobError, load_job
 from .runner import run_job
 
@@ -79,17 +79,6 @@ def _refuse_shared_outputs(paths: list[str]) -> None:
                     f"({other}, {directory}): give each job a folder of its own"
                 )
         seen[directory] = path
-
-
-def _limit_threads(threads: int) -> None:
-    """Keep each worker's numerical libraries to its share of the cores."""
-    for variable in (
-        "MKL_NUM_THREADS",
-        "OMP_NUM_THREADS",
-        "OPENBLAS_NUM_THREADS",
-        "NUMBA_NUM_THREADS",
-    ):
-        os.environ[variable] = str(threads)
 
 
 def run_job_file(path: str, force: bool = False) -> JobStatus:
@@ -157,13 +146,7 @@ def run_batch(
                 finished(future.result())
     else:
         workers = max(1, workers or os.cpu_count() or 1)
-        threads = max(1, (os.cpu_count() or 1) // workers)
-        with ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=get_context("spawn"),
-            initializer=_limit_threads,
-            initargs=(threads,),
-        ) as pool:
+        with process_pool(workers) as pool:
             futures = [pool.submit(run_job_file, path, force) for path in paths]
             for future in as_completed(futures):
                 finished(future.result())

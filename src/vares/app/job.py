@@ -255,14 +255,19 @@ def _toml_string(text: str) -> str:
         raise JobError(f"cannot write {text!r} to a job file: it is not valid Unicode") from None
 
 
-def load_job(path: str | Path) -> Job:
-    """Read and check a job file."""
+def read_job_file(path: str | Path) -> dict[str, Any]:
+    """The tables of a job file (TOML), with one-line errors for a missing or unreadable one."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise JobError(f"{path}: not valid TOML: {exc}") from exc
-    job = Job.from_dict(data, str(path), path.parent.resolve())
+
+
+def load_job(path: str | Path) -> Job:
+    """Read and check a job file."""
+    path = Path(path)
+    job = Job.from_dict(read_job_file(path), str(path), path.parent.resolve())
     return replace(job, location=path.resolve())

@@ -40,7 +40,6 @@ as are the tables and keys a laminate job does not use (``[prestress]``, ``[outp
 from __future__ import annotations
 
 import difflib
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -48,7 +47,7 @@ from typing import Any
 from ..options import Options, OptionsError, suggest
 from ..structures.laminate import Ply
 from ..structures.laminate_options import LaminateOptions, PlyOptions
-from .job import SECTIONS, Job, JobError
+from .job import SECTIONS, Job, JobError, read_job_file
 from .sections import MaterialOptions
 
 __all__ = ["LAMINATE_TABLES", "LaminateJob", "load_laminate_job"]
@@ -181,11 +180,5 @@ def _table(cls: type[Options], values: Any, origin: str, where: str) -> Any:
 def load_laminate_job(path: str | Path) -> LaminateJob:
     """Read and check a laminate job file (relative paths are relative to its folder)."""
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no such file: {path}")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise JobError(f"{path}: not valid TOML: {exc}") from exc
-    job = LaminateJob.from_dict(data, str(path), path.parent.resolve())
+    job = LaminateJob.from_dict(read_job_file(path), str(path), path.parent.resolve())
     return replace(job, job=replace(job.job, location=path.resolve()))

@@ -20,9 +20,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 from typing import Any
 
 import numpy as np
@@ -33,6 +31,7 @@ from ..geometry.elements import ELEMENTS, inverse
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..options import OptionsError, split_settings, takes_options
+from ..parallel import process_pool
 from ..solver.api import solve
 from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
@@ -376,11 +375,6 @@ def _drape_one(task: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def _limit_threads(threads: int) -> None:
-    for variable in ("MKL_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
-        os.environ[variable] = str(threads)
-
-
 def _label(orientation: float, taken: Sequence[str]) -> str:
     base = f"{orientation:g}°"
     label, count = base, 1
@@ -483,13 +477,7 @@ def drape_laminate(
     default = (os.cpu_count() or 1) if mesh.num_cells >= PARALLEL_CELLS else 1
     workers = min(options.workers or default, len(tasks))
     if workers > 1:
-        threads = max(1, (os.cpu_count() or 1) // workers)
-        with ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=get_context("spawn"),
-            initializer=_limit_threads,
-            initargs=(threads,),
-        ) as pool:
+        with process_pool(workers) as pool:
             outcomes = list(pool.map(_drape_one, tasks))
     else:
         outcomes = [_drape_one(task) for task in tasks]
