@@ -151,34 +151,42 @@ class YarnSmoothing:
             ]
         )
         vals = np.concatenate([np.full(c.size, 1.0 / c.shape[1]) for c in cells_all])
+        #: ``(n, cells)``: the share of each cell's integrals in each node's smoothing domain
         self._share = sp.csr_matrix((vals, (rows, cols)), shape=(n, int(self._offsets[-1])))
-        # the nodes of each node's patch (k first), padded with k
-        adjacency = sp.csr_matrix(
-            (np.ones(rows.size), (rows, cols)), shape=self._share.shape
-        ) @ sp.csr_matrix((np.ones(rows.size), (cols, rows)), shape=self._share.shape[::-1])
-        adjacency = adjacency.tocsr()
+        self._share.sum_duplicates()
+        self._share.sort_indices()
+        # the nodes of each node's patch: the nodes of its cells, padded with the first
+        cell_nodes = sp.csr_matrix(
+            (np.ones(rows.size), (cols, rows)), shape=(int(self._offsets[-1]), n)
+        )
+        adjacency = (self._share @ cell_nodes).tocsr()
         adjacency.sum_duplicates()
+        adjacency.sort_indices()
         size = int(np.diff(adjacency.indptr).max())
-        patches = np.repeat(np.arange(n)[:, None], size, axis=1)
+        patches = np.empty((n, size), dtype=np.int64)
         slot_of: dict[tuple[int, int], int] = {}
         for k in range(n):
-            others = adjacency.indices[adjacency.indptr[k] : adjacency.indptr[k + 1]]
-            others = others[others != k]
-            patches[k, 1 : 1 + others.size] = others
-            slot_of.update({(k, int(b)): s + 1 for s, b in enumerate(others)})
-            slot_of[(k, k)] = 0
+            members = adjacency.indices[adjacency.indptr[k] : adjacency.indptr[k + 1]]
+            patches[k, : members.size] = members
+            patches[k, members.size :] = members[0]
+            slot_of.update({(k, int(b)): s for s, b in enumerate(members)})
         self.patches = patches
         # every (node k, cell e ∋ k): the patch slot of each of e's nodes, per block
+        coo = self._share.tocoo()
         self._incidence = []
-        for c in cells_all:
-            m, nen = c.shape
-            node = c.ravel()  # (m nen,) patch centre for each incidence
-            cell = np.repeat(np.arange(m), nen)
+        for index, c in enumerate(cells_all):
+            lo, hi = self._offsets[index], self._offsets[index + 1]
+            chosen = (coo.col >= lo) & (coo.col < hi)
+            domain, cell, weight = coo.row[chosen], coo.col[chosen] - lo, coo.data[chosen]
             slots = np.array(
-                [slot_of[(int(k), int(b))] for k, e in zip(node, cell, strict=True) for b in c[e]],
+                [
+                    slot_of[(int(k), int(b))]
+                    for k, e in zip(domain, cell, strict=True)
+                    for b in c[e]
+                ],
                 dtype=np.int64,
-            ).reshape(m * nen, nen)
-            self._incidence.append((node, cell, slots))
+            ).reshape(domain.size, c.shape[1])
+            self._incidence.append((domain, cell, weight, slots))
 
     @property
     def connectivity(self) -> Connectivity:
@@ -267,7 +275,7 @@ class YarnSmoothing:
         """
         terms = self._quadrature_terms(coordinates, metrics, order)
         u, smoothed, nodal_energy, lam, d2psi = self._nodal([t[0] for t in terms])
-        n = self.mesh.num_points
+        n = self.patches.shape[0]
         # each cell's share of node k's energy, in proportion to its share of a_k
         share_of_a = self._share.multiply(
             np.concatenate([t[0][:, 0] for t in terms])[None, :]
@@ -329,14 +337,13 @@ class YarnSmoothing:
         n, size = self.patches.shape
         dtype = np.result_type(u, *[t[1] for t in terms])
         out = np.zeros((n, 2, size, 2), dtype=dtype)
-        for (node, cell, slots), term in zip(self._incidence, terms, strict=True):
+        for (node, cell, weight, slots), term in zip(self._incidence, terms, strict=True):
             g = term[1]  # (m, 3, nen, 2)
-            nen = g.shape[2]
-            a = u[node, 0]
+            scale = (weight / u[node, 0])[:, None, None]
             for j in range(2):
-                contribution = (g[cell, 1 + j] - smoothed[node, j][:, None, None] * g[cell, 0]) / (
-                    nen * a
-                )[:, None, None]
+                contribution = scale * (
+                    g[cell, 1 + j] - smoothed[node, j][:, None, None] * g[cell, 0]
+                )
                 np.add.at(out, (node[:, None], j, slots), contribution)
         return out
 
