@@ -5,7 +5,8 @@ radius 100 mm cut at the equator, irregular triangles (``irregular_cap(100, 90, 
 warp along x. The yarn shear angle along the four 45° meridians (cells whose centroid lies within
 3° of the meridian's azimuth and 2.5° of the polar angle, signed so that all four are positive)
 against the kinematic net of the exact sphere, for the cell-wise law (``yarn_strain="element"``,
-what ``vares.solve`` does) and node-smoothed yarn stretches (``yarn_strain="smoothed"``), both
+what ``vares.solve`` does), yarn stretches smoothed over each node's domain
+(``yarn_strain="smoothed"``) and over the domains of pairs of nodes (``"paired"``), all
 started from the kinematic net's pattern on the same mesh, the warp aligned with x by the
 solver's secant iteration.
 
@@ -53,7 +54,7 @@ def run(
         mesh,
         material,
         yarn_strain=yarn_strain,
-        yarn_stabilisation=stabilisation / ratio if yarn_strain == "smoothed" else 0.0,
+        yarn_stabilisation=stabilisation / ratio if yarn_strain != "element" else 0.0,
         warp_direction=(1, 0, 0),
         initial_guess=start,
     )
@@ -76,7 +77,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rings", type=int, nargs="+", default=[40])
     parser.add_argument("--ratios", type=float, nargs="+", default=[1e4, 1e6])
-    parser.add_argument("--yarn-strain", nargs="+", default=["element", "smoothed"])
+    parser.add_argument("--yarn-strain", nargs="+", default=["element", "smoothed", "paired"])
     parser.add_argument(
         "--stabilisation",
         type=float,

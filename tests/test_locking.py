@@ -17,6 +17,7 @@ from vares.materials import (
 )
 from vares.mechanics import Assembler
 from vares.mechanics.problem import Problem
+from vares.mechanics.yarn_smoothing import paired_domains
 
 LAWS = {
     "orthotropic": OrthotropicStVenantKirchhoff(100.0, 80.0, 1.0, 0.2),
@@ -59,7 +60,8 @@ def complex_step_check(problem: Problem, x: np.ndarray, probes: int = 10) -> tup
 
 @pytest.mark.parametrize("law", LAWS)
 @pytest.mark.parametrize("stabilisation", [0.0, 0.3])
-def test_derivatives_against_complex_step(law, stabilisation):
+@pytest.mark.parametrize("yarn_strain", ["smoothed", "paired"])
+def test_derivatives_against_complex_step(law, stabilisation, yarn_strain):
     mesh = irregular_cap(100.0, 40.0, 4, 0.3, 1)
     x = 1.02 * mesh.points[:, :2] + np.random.default_rng(0).normal(0, 0.3, (mesh.num_points, 2))
     problem = Problem(
@@ -68,7 +70,7 @@ def test_derivatives_against_complex_step(law, stabilisation):
         1.3,
         fibres=Fibres.from_angles(17.0),
         prestress=(0.4, 0.2),
-        yarn_strain="smoothed",
+        yarn_strain=yarn_strain,
         yarn_stabilisation=stabilisation,
     )
     gradient_error, hessian_error = complex_step_check(problem, x)
@@ -77,12 +79,13 @@ def test_derivatives_against_complex_step(law, stabilisation):
 
 
 @pytest.mark.parametrize("law", LAWS)
-def test_derivatives_on_quads_and_triangles(law):
+@pytest.mark.parametrize("yarn_strain", ["smoothed", "paired"])
+def test_derivatives_on_quads_and_triangles(law, yarn_strain):
     mesh = mixed_mesh()
     x = mesh.points[:, :2] * [1.05, 0.97] + np.random.default_rng(2).normal(
         0, 0.01, (mesh.num_points, 2)
     )
-    problem = Problem(mesh, LAWS[law], fibres=Fibres.from_angles(-30.0), yarn_strain="smoothed")
+    problem = Problem(mesh, LAWS[law], fibres=Fibres.from_angles(-30.0), yarn_strain=yarn_strain)
     gradient_error, hessian_error = complex_step_check(problem, x)
     assert gradient_error < 1e-12
     assert hessian_error < 1e-12
@@ -108,7 +111,8 @@ def flat_disk() -> SurfaceMesh:
 
 
 @pytest.mark.parametrize("law", LAWS)
-def test_patch_test_uniform_stretch(law):
+@pytest.mark.parametrize("yarn_strain", ["smoothed", "paired"])
+def test_patch_test_uniform_stretch(law, yarn_strain):
     """A uniform stretch has every smoothed stretch equal to every cell's: energy and residual
     those of the cell-wise law."""
     mesh = flat_disk()
@@ -116,7 +120,7 @@ def test_patch_test_uniform_stretch(law):
     x = mesh.points[:, :2] @ stretch.T
     kwargs = {"fibres": Fibres.from_angles(25.0), "prestress": (0.3, 0.1)}
     element = Problem(mesh, LAWS[law], 2.0, **kwargs)
-    smoothed = Problem(mesh, LAWS[law], 2.0, yarn_strain="smoothed", **kwargs)
+    smoothed = Problem(mesh, LAWS[law], 2.0, yarn_strain=yarn_strain, **kwargs)
     a, b = element.evaluate(x, order=1), smoothed.evaluate(x, order=1)
     assert b.energy == pytest.approx(a.energy, rel=1e-12)
     ga = Assembler(element.connectivity, np.ones(x.size, bool)).vector(a.gradients)
@@ -130,7 +134,7 @@ def test_patch_test_prestressed_disk_solves_to_a_uniform_stretch():
     mesh = flat_disk()
     law = LAWS["orthotropic"]
     patterns = []
-    for yarn_strain in ("element", "smoothed"):
+    for yarn_strain in ("element", "smoothed", "paired"):
         result = solve_yarn_strain(
             mesh,
             law,
@@ -145,7 +149,19 @@ def test_patch_test_prestressed_disk_solves_to_a_uniform_stretch():
         affine, *_ = np.linalg.lstsq(plane, pattern, rcond=None)
         assert np.abs(plane @ affine - pattern).max() < 1e-9 * 87.0
         assert abs(np.linalg.det(affine[:2]) - 1.0) > 1e-3  # a real stretch, not the disk
-    assert np.abs(patterns[1] - patterns[0]).max() < 1e-9 * 87.0
+    for pattern in patterns[1:]:
+        assert np.abs(pattern - patterns[0]).max() < 1e-9 * 87.0
+
+
+def test_paired_domains_join_two_neighbours():
+    mesh = irregular_cap(100.0, 90.0, 10, 0.3, 1)
+    domains = paired_domains(mesh)
+    sizes = np.bincount(domains)
+    assert sizes.max() == 2 and (sizes == 2).sum() * 2 > 0.9 * mesh.num_points
+    edges = {tuple(sorted(e)) for e in mesh.edges().tolist()}
+    for d in np.flatnonzero(sizes == 2):
+        a, b = np.flatnonzero(domains == d)
+        assert (a, b) in edges
 
 
 def test_unsupported_settings_are_refused():

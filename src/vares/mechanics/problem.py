@@ -19,7 +19,7 @@ from ..materials import Fibres, Hyperelastic, MaterialError
 from .assembly import Connectivity
 from .kernels import block_energy, determinant, projected_hessian
 from .prestress import prestress_components, prestress_tensor
-from .yarn_smoothing import YARN_STRAINS, YarnSmoothing
+from .yarn_smoothing import YARN_STRAINS, YarnSmoothing, paired_domains
 
 __all__ = ["Evaluation", "Problem", "first_positive_root"]
 
@@ -57,10 +57,11 @@ class Problem:
     yarn_strain
         ``"element"``: the law per quadrature point; ``"smoothed"``: the yarn stretches of a
         fibre law averaged over node patches, the shear per cell (no intra-ply shear locking; see
-        :mod:`vares.mechanics.yarn_smoothing`). The per-block arrays then end with the patch
-        block, assembled over :attr:`connectivity`.
+        :mod:`vares.mechanics.yarn_smoothing`); ``"paired"``: averaged over the domains of pairs
+        of nodes (:func:`~vares.mechanics.yarn_smoothing.paired_domains`). The per-block arrays
+        then end with the patch block, assembled over :attr:`connectivity`.
     yarn_stabilisation
-        With ``"smoothed"``: the share of the yarn part kept per cell (see
+        With smoothed yarn strains: the share of the yarn part kept per cell (see
         :class:`~vares.mechanics.yarn_smoothing.YarnSmoothing`).
     """
 
@@ -102,8 +103,15 @@ class Problem:
         self.yarn_strain = yarn_strain
         self.yarn_stabilisation = float(yarn_stabilisation)
         self._smoothing = (
-            YarnSmoothing(mesh, material, fibres, self.thickness, yarn_stabilisation)
-            if yarn_strain == "smoothed"
+            YarnSmoothing(
+                mesh,
+                material,
+                fibres,
+                self.thickness,
+                yarn_stabilisation,
+                domains=paired_domains(mesh) if yarn_strain == "paired" else None,
+            )
+            if yarn_strain != "element"
             else None
         )
 

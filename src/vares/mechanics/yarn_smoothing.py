@@ -47,10 +47,11 @@ from ..materials import Fibres, Hyperelastic, MaterialError
 from .assembly import Connectivity
 from .kernels import _nodal_hessian, block_energy, projected_hessian
 
-__all__ = ["PATCH_BLOCK", "YARN_STRAINS", "ShearPart", "YarnSmoothing"]
+__all__ = ["PATCH_BLOCK", "YARN_STRAINS", "ShearPart", "YarnSmoothing", "paired_domains"]
 
-#: The settings of ``Problem(yarn_strain=...)``: per cell, or smoothed over node patches.
-YARN_STRAINS = ("element", "smoothed")
+#: The settings of ``Problem(yarn_strain=...)``: per cell, smoothed over each node's domain, or
+#: over the domains of pairs of nodes (:func:`paired_domains`).
+YARN_STRAINS = ("element", "smoothed", "paired")
 #: Name of the block of node patches in :attr:`YarnSmoothing.connectivity`.
 PATCH_BLOCK = "yarn_patch"
 
@@ -125,6 +126,9 @@ class YarnSmoothing:
         with the smoothed stretches, ``β`` with each cell's own (0: fully smoothed). A share of
         the order of ``G12/E`` stiffens the yarn-stretch modes the smoothing leaves to the shear
         alone without bringing back the cell-wise constraints.
+    domains
+        The smoothing domain of every node ``(n,)``, numbered from 0 (default: one per node);
+        a domain of several nodes is the union of theirs.
     """
 
     def __init__(
@@ -134,6 +138,7 @@ class YarnSmoothing:
         fibres: Fibres,
         thickness: float,
         stabilisation: float = 0.0,
+        domains: np.ndarray | None = None,
     ) -> None:
         if not 0.0 <= stabilisation < 1.0:
             raise ValueError(f"stabilisation must lie in [0, 1); got {stabilisation!r}")
@@ -156,8 +161,14 @@ class YarnSmoothing:
             ]
         )
         vals = np.concatenate([np.full(c.size, 1.0 / c.shape[1]) for c in cells_all])
-        #: ``(n, cells)``: the share of each cell's integrals in each node's smoothing domain
-        self._share = sp.csr_matrix((vals, (rows, cols)), shape=(n, int(self._offsets[-1])))
+        node_share = sp.csr_matrix((vals, (rows, cols)), shape=(n, int(self._offsets[-1])))
+        domain_of = np.arange(n) if domains is None else np.asarray(domains, dtype=np.int64)
+        if domain_of.shape != (n,) or set(np.unique(domain_of)) != set(range(domain_of.max() + 1)):
+            raise ValueError("domains must number every node's domain from 0 without gaps")
+        count = int(domain_of.max()) + 1
+        merge = sp.csr_matrix((np.ones(n), (domain_of, np.arange(n))), shape=(count, n))
+        #: ``(domains, cells)``: the share of each cell's integrals in each smoothing domain
+        self._share = (merge @ node_share).tocsr()
         self._share.sum_duplicates()
         self._share.sort_indices()
         # the nodes of each node's patch: the nodes of its cells, padded with the first
@@ -168,9 +179,9 @@ class YarnSmoothing:
         adjacency.sum_duplicates()
         adjacency.sort_indices()
         size = int(np.diff(adjacency.indptr).max())
-        patches = np.empty((n, size), dtype=np.int64)
+        patches = np.empty((count, size), dtype=np.int64)
         slot_of: dict[tuple[int, int], int] = {}
-        for k in range(n):
+        for k in range(count):
             members = adjacency.indices[adjacency.indptr[k] : adjacency.indptr[k + 1]]
             patches[k, : members.size] = members
             patches[k, members.size :] = members[0]
@@ -384,3 +395,23 @@ class YarnSmoothing:
         ]
         out.append(stored[-1])
         return out
+
+
+def paired_domains(mesh: SurfaceMesh) -> np.ndarray:
+    """Smoothing domains of two nodes joined by an edge ``(n,)``: a greedy matching over the
+    edges, shortest first (a node left without a free neighbour keeps a domain of its own).
+
+    Two stretch constraints per pair of nodes leave the yarns about half the unknowns, where one
+    domain per node leaves them none (docs/locking.md).
+    """
+    edges = mesh.edges()
+    lengths = np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1)
+    domain = np.full(mesh.num_points, -1, dtype=np.int64)
+    count = 0
+    for a, b in edges[np.argsort(lengths, kind="stable")]:
+        if domain[a] < 0 and domain[b] < 0:
+            domain[a] = domain[b] = count
+            count += 1
+    single = np.flatnonzero(domain < 0)
+    domain[single] = count + np.arange(single.size)
+    return domain
