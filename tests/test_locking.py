@@ -178,8 +178,9 @@ NET = np.array([7.52, 16.11, 26.95, 39.27])  # exact-sphere net at 30, 45, 60, 7
 def test_symmetric_meridians_agree_with_smoothed_yarns_not_with_cellwise_yarns():
     """Hemisphere R = 100 mm of 2,400 irregular triangles, woven ply E/G = 1e4, warp along x:
     the four 45° meridians must carry the same shear. Cell by cell the yarns lock (spread
-    6–8°, up to 4.5° off the net); smoothed they agree within 2.8° (the kinematic net on this
-    mesh itself spreads by 1.6–2.6°) and stay within 2.2° of the net."""
+    6–8°, up to 4.5° off the net); smoothed over nodes they agree within 2.8° and stay within
+    2.2° of the net, over pairs of nodes within 1.7° and 1.9° (the kinematic net on this mesh
+    itself spreads by 1.6–2.6°)."""
     mesh = irregular_cap(100.0, 90.0, 20, 0.3, 1)
     start = kinematic_drape(
         mesh, seed=(0, 0, 100), warp_direction=(1, 0, 0), spacing=1.0
@@ -187,7 +188,11 @@ def test_symmetric_meridians_agree_with_smoothed_yarns_not_with_cellwise_yarns()
     ratio = 1e4
     law = OrthotropicStVenantKirchhoff(E1=ratio, E2=ratio, G12=1.0, nu12=0.0)
     spreads, errors = {}, {}
-    for yarn_strain, stabilisation in (("element", 0.0), ("smoothed", 10.0 / ratio)):
+    for yarn_strain, stabilisation in (
+        ("element", 0.0),
+        ("smoothed", 10.0 / ratio),
+        ("paired", 10.0 / ratio),
+    ):
         result = solve_yarn_strain(
             mesh,
             law,
@@ -197,7 +202,7 @@ def test_symmetric_meridians_agree_with_smoothed_yarns_not_with_cellwise_yarns()
             initial_guess=start,
         )
         assert result.converged
-        assert result.iterations < 40
+        assert result.iterations < 60
         table = meridian_shear(mesh, cell_shear_angle(mesh, result.coordinates, law, result.fibres))
         assert not np.isnan(table).any()
         spreads[yarn_strain] = (table.max(axis=0) - table.min(axis=0)).max()
@@ -206,3 +211,5 @@ def test_symmetric_meridians_agree_with_smoothed_yarns_not_with_cellwise_yarns()
     assert spreads["smoothed"] < 3.0
     assert spreads["smoothed"] < 0.45 * spreads["element"]
     assert errors["smoothed"] < 2.5 < 4.0 < errors["element"]
+    assert spreads["paired"] < 1.8  # the kinematic net on this mesh: 2.6
+    assert errors["paired"] < 2.0
