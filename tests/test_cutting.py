@@ -332,3 +332,26 @@ def test_a_per_cell_prestress_follows_the_cells_the_strips_are_cut_from():
         vares.cut(
             mesh, vares.materials.NeoHooke(E=600.0, nu=0.3), prestress=rows[:-1], roll_width=2.0
         )
+
+
+def test_planned_lines_that_meet_refine_the_surface_then_become_plane_sections(monkeypatch):
+    """Should planned geodesics meet (forced here), the surface is refined twice more, then the
+    lines are plane sections, which keep apart: the plan is made, no error."""
+    from vares.geometry.cutting import LinesMeetError
+    from vares.structures import layout
+
+    real, calls = layout._layout, []
+
+    def meeting(surface, family, spans, seams, *rest):
+        calls.append((seams, len(surface.cells["triangle"])))
+        if seams == "geodesic" and len(spans) > 1:
+            raise LinesMeetError("cutting lines 1 and 2 meet")
+        return real(surface, family, spans, seams, *rest)
+
+    monkeypatch.setattr(layout, "_layout", meeting)
+    mesh = saddle(size=8.0, height=1.6, n=12)
+    plan = plan_strips(mesh, 2.0)
+    assert max(plan.widths) <= 2.0 and len(plan.lines) >= 3
+    assert plan.refinements == 2 and plan.replaced_geodesics == len(plan.lines)
+    assert plan.refined_cells == 16 * len(mesh.cells["triangle"])
+    assert {"geodesic", "planar"} <= {seams for seams, _ in calls}
