@@ -33,6 +33,7 @@ from vares.materials.biaxial_model import (
     simulate,
     specimen_batch,
 )
+from vares.materials.fabric_file import fit_toml
 from vares.materials.fitting import compensation_values, fit_elastic, fit_fabric
 
 PRESTRESS = (2.0, 1.5)
@@ -132,7 +133,7 @@ def main() -> None:
         prestress=PRESTRESS,
     )
     target = args.records / "pes-batch-42.toml"
-    target.write_text(fitted.to_toml(), encoding="utf-8")
+    target.write_text(fit_toml(fitted), encoding="utf-8")
     m, s = fitted.constants.mean, fitted.constants.std
     print(f"pes-batch-42 ({fitted.constants.specimens} stiffness specimens):")
     for name in ("E_w", "E_f", "nu_wf", "nu_fw"):

@@ -402,16 +402,6 @@ class FabricFit:
             return None
         return law_compensation(self.material("law"), self.prestress)
 
-    def to_toml(self, compensate_by: str | None = None, description: str | None = None) -> str:
-        """The fabric file of this fit (:func:`vares.materials.fabric_file.fit_toml`).
-
-        ``compensate_by``: the pattern's default compensation (``"measured"`` when there are
-        compensation values, else ``"law"``); ``description`` defaults to one naming the
-        specimens and the evaluation."""
-        from .fabric_file import fit_toml
-
-        return fit_toml(self, compensate_by, description)
-
 
 def fit_fabric(
     records: list[BiaxialRecord],

@@ -105,6 +105,7 @@ def fit(
         from ...io.biaxial import read_biaxial
         from ...io.files import check_writable, write_text
         from ...materials import fabric
+        from ...materials.fabric_file import fit_toml
         from ...materials.fitting import fit_fabric
 
         if output.suffix != ".toml":
@@ -134,7 +135,7 @@ def fit(
             cycle=cycle,
             reciprocal=reciprocal,
         )
-        text = fitted.to_toml(compensate_by)
+        text = fit_toml(fitted, compensate_by)
         if plots is not None:
             from ...io.fabric_plots import fabric_figures, figure_paths
 
