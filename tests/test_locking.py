@@ -256,3 +256,53 @@ def test_pairs_do_not_lock_at_yarn_to_shear_stiffness_1e6():
         mesh, cell_shear_angle(mesh, cellwise.coordinates, stiff, cellwise.fibres)
     )
     assert (locked.max(axis=0) - locked.min(axis=0)).max() > 9.0
+
+
+def test_the_yarn_strain_is_a_solve_option_of_the_api_job_files_and_command_line(tmp_path):
+    """`yarn_strain` and `yarn_stabilisation` are options of every solve: the command line's
+    `--yarn-strain paired` gives the pattern the API gives, which differs from cell by cell."""
+    import json
+
+    import meshio
+    from conftest import run
+
+    import vares
+
+    mesh = irregular_cap(100.0, 60.0, 8, 0.3, 1)
+    law = OrthotropicStVenantKirchhoff(E1=1e3, E2=1e3, G12=1.0, nu12=0.0)
+    paired = vares.solve(mesh, law, yarn_strain="paired", yarn_stabilisation=0.01)
+    cellwise = vares.solve(mesh, law)
+    assert paired.converged and cellwise.converged
+    assert np.abs(paired.material_coordinates - cellwise.material_coordinates).max() > 1e-3
+    source = tmp_path / "cap.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+    flags = [
+        "--material",
+        "orthotropic",
+        "--E1",
+        "1000",
+        "--E2",
+        "1000",
+        "--G12",
+        "1",
+        "--nu12",
+        "0",
+    ]
+    result = run(
+        "pattern",
+        source,
+        "-o",
+        tmp_path / "p",
+        *flags,
+        "--yarn-strain",
+        "paired",
+        "--yarn-stabilisation",
+        "0.01",
+        "--no-previews",
+        "-q",
+    )
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "p" / "summary.json").read_text())
+    assert summary["options"]["yarn_strain"] == "paired"
+    written = meshio.read(tmp_path / "p" / "pattern.obj").points[:, :2]
+    np.testing.assert_allclose(written, paired.material_coordinates, atol=1e-6)

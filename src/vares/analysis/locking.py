@@ -1,15 +1,14 @@
 """Stiff-yarn plies on linear cells: a solve with a chosen yarn-strain treatment, and the shear
 along the meridians of a cap (the intra-ply shear locking check of DESIGN.md §8).
 
-:func:`solve_yarn_strain` runs the strategy of :func:`vares.solve` (its initial guess, plan and
-warp alignment) on a :class:`~vares.mechanics.problem.Problem` with ``yarn_strain`` set, assembled
-over the problem's connectivity; :func:`meridian_shear` samples a per-cell field along
-meridians of a surface of revolution about the z axis.
+:func:`solve_yarn_strain` is :func:`vares.solve` with ``yarn_strain`` set (the solve assembles
+over the problem's connectivity), returning the problem beside the pattern;
+:func:`meridian_shear` samples a per-cell field along meridians of a surface of revolution about
+the z axis.
 """
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -17,17 +16,11 @@ import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic
-from ..mechanics.assembly import Assembler
 from ..mechanics.fields import cell_fields
 from ..mechanics.problem import Problem
-from ..mechanics.rigid import rigid_modes
-from ..solver.alignment import align_warp, fibre_angle, initial_fibres, rotated
-from ..solver.linear import get_solver, quiet_blas
-from ..solver.newton import Failure, NewtonContext
+from ..solver.api import solve
 from ..solver.options import SolveOptions
 from ..solver.result import IterationRecord
-from ..solver.start import initial_guess as first_guess
-from ..solver.strategies import follow_plan, plan
 
 __all__ = ["SmoothedSolve", "cell_shear_angle", "meridian_shear", "solve_yarn_strain"]
 
@@ -69,64 +62,32 @@ def solve_yarn_strain(
     with ``warp_direction`` (a 3D direction) the yarns are turned until the mean erected warp
     follows it.
     """
-    options = options or SolveOptions()
-    started = time.perf_counter()
-    with quiet_blas():
-        start = first_guess(mesh, options, initial_guess)
-        fibres = Fibres.from_angles(options.warp_angle, options.fill_angle)
-
-        def make_problem(f: Fibres) -> Problem:
-            return Problem(
-                mesh,
-                material,
-                thickness,
-                fibres=f,
-                prestress=prestress,
-                yarn_strain=yarn_strain,
-                yarn_stabilisation=yarn_stabilisation,
-            )
-
-        problem = make_problem(fibres)
-        free, constraint = rigid_modes(start.coordinates, options.orientation)
-        history: list[IterationRecord] = []
-        ctx = NewtonContext(
-            assembler=Assembler(problem.connectivity, free),
-            linear_solver=get_solver(options.linear_solver),
-            residual_tolerance=options.tolerance * problem.force_scale,
-            energy_noise=1e-13 * material.stiffness_scale * thickness * mesh.area,
-            force_scale=problem.force_scale,
-            max_iterations=options.max_iterations,
-            history=history,
-            steps=[],
-            callback=None,
-            constraint=constraint,
-        )
-        x = start.coordinates
-        direction = None if warp_direction is None else np.asarray(warp_direction, float)
-        if direction is not None:
-            fibres = initial_fibres(fibres, options.warp_angle, x, problem, direction)
-            problem = make_problem(fibres)
-        attempts = plan(options.strategy, options.steps, start.plane is not None)
-        x, _, reason = follow_plan(problem, x, start.plane, attempts, ctx, options.damping)
-        if reason is None and direction is not None:
-            try:
-                x, fibres, _ = align_warp(make_problem, x, fibres, direction, ctx, options.damping)
-            except Failure as failure:
-                reason, x = failure.reason, failure.coordinates
-            turn = fibre_angle(fibres.warp)
-            x = rotated(x, -turn)
-            fibres = Fibres.from_angles(0.0, fibre_angle(fibres.fill) - turn)
-            problem = make_problem(fibres)
-    iterations = sum(1 for record in history if record.iteration > 0)
+    options = (options or SolveOptions()).replace(
+        yarn_strain=yarn_strain,
+        yarn_stabilisation=yarn_stabilisation,
+        warp_direction=None if warp_direction is None else tuple(warp_direction),
+    )
+    result = solve(
+        mesh, material, thickness, prestress=prestress, options=options, initial_guess=initial_guess
+    )
+    problem = Problem(
+        mesh,
+        material,
+        thickness,
+        fibres=result.fibres,
+        prestress=prestress,
+        yarn_strain=yarn_strain,
+        yarn_stabilisation=yarn_stabilisation,
+    )
     return SmoothedSolve(
-        x,
-        fibres,
+        result.material_coordinates,
+        result.fibres,
         problem,
-        reason is None,
-        reason,
-        iterations,
-        time.perf_counter() - started,
-        history,
+        result.converged,
+        result.reason,
+        result.iterations,
+        result.elapsed,
+        result.history,
     )
 
 

@@ -193,7 +193,13 @@ class _Run:
 
     def problem(self, fibres: Fibres) -> Problem:
         return Problem(
-            self.mesh, self.material, self.thickness, fibres=fibres, prestress=self.prestress
+            self.mesh,
+            self.material,
+            self.thickness,
+            fibres=fibres,
+            prestress=self.prestress,
+            yarn_strain=self.options.yarn_strain,
+            yarn_stabilisation=self.options.yarn_stabilisation,
         )
 
     def attempt(self, start: Start, restart: bool = False) -> _Attempt:
@@ -242,7 +248,7 @@ class _Run:
         self.solver_name = solver.name
         scale = self.material.stiffness_scale * problem.thickness * self.mesh.area
         return NewtonContext(
-            assembler=Assembler(self.mesh, free),
+            assembler=Assembler(problem.connectivity, free),
             linear_solver=solver,
             residual_tolerance=self.options.tolerance * problem.force_scale,
             energy_noise=ENERGY_NOISE * scale,

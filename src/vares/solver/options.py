@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..mechanics.yarn_smoothing import YARN_STRAINS
 from ..options import Options, OptionsError, option
 from .linear import SOLVER_NAMES
 
@@ -51,6 +52,23 @@ class SolveOptions(Options):
         "energy choose it (free).",
         section="fibres",
         choices=ORIENTATIONS,
+    )
+    yarn_strain: str = option(
+        "element",
+        "str",
+        "Yarn stretches of the fabric laws cell by cell (element), or averaged over each node's "
+        "cells (smoothed) or over pairs of neighbouring nodes (paired): stiff yarns on triangles "
+        "that follow no yarn without intra-ply shear locking (docs/locking.md).",
+        section="fibres",
+        choices=YARN_STRAINS,
+    )
+    yarn_stabilisation: float = option(
+        0.0,
+        "float",
+        "With smoothed or paired yarn stretches: the share of the yarn energy kept cell by cell "
+        "(stabilises the smoothed domains; docs/locking.md uses 10 × G/E).",
+        section="fibres",
+        minimum=0,
     )
     strategy: str = option(
         "auto",
