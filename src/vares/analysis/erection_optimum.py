@@ -4,18 +4,18 @@ VaReS minimises the energy of erecting the pattern *onto the design shape*. The 
 patterns make settles elsewhere (:func:`vares.erect`): its forces differ from the intended
 prestress and its shape from the design. Here the patterns ``X`` are changed so that the erected
 equilibrium ``x*(X)`` (``R(x*, X) = 0``) carries the intended prestress and keeps the design's
-shape, by least squares:
+shape, by least squares (:mod:`vares.analysis.erection_residuals`):
 
     J(X) = Σ_cells A_e Σ_yarn (n(x*, X) − n_intended)² / (A s₀²)
-           + w Σ_nodes a_i d_i(x*)² / (A d₀²)
-           + Σ_seams (ℓ_P(X) − ℓ_Q(X))² / (A_seam h²)
+           + 30 Σ_yarn (mean n − mean n_intended)² / s₀²
+           + w Σ_nodes a_i d_i(x*)² / (A d₀²) + 100 Σ_{|d_i| > b} a_i (|d_i| − b)² / (A d₀²)
 
 ``n`` the membrane forces along warp and fill, ``d`` the normal deviation from the design, ``A_e``
 and ``a_i`` the cells' and nodes' design areas, ``s₀`` and ``d₀`` the RMS force deviation and RMS
-shape deviation of the starting patterns' erection (so ``J`` starts at ``1 + w`` and
-``shape_weight`` ``w`` weighs a relative gain in shape against one in force), and the last term
-keeps every seam equally long in the two patterns it joins (``ℓ`` the lengths of a welded seam
-edge in each, ``h`` a strain of 1e-6 of the edge's design length: a soft but stiff constraint).
+shape deviation of the starting patterns' erection (``shape_weight`` ``w`` weighs a relative gain
+in shape against one in force), ``b`` the bound on the shape deviation (``shape_bound`` × the
+start's largest). Seams are constraints: every seam edge equally long in the two patterns it
+joins, each step projected onto them and the patterns matched again to round-off after it.
 
 The minimisation is Levenberg–Marquardt (a Gauss–Newton model of ``J``, damped by ``μ``; a step
 is taken only if ``J`` falls, ``μ`` follows the ratio of the actual to the predicted decrease).
@@ -23,8 +23,9 @@ Its Jacobian is never formed: products with it and its transpose take one solve 
 erection's tangent ``K`` (factorised once per iteration), ``dx* = −K⁻¹ (∂R/∂X) dX`` and the
 adjoint ``Jᵀu = ∂r/∂Xᵀ u − (∂R/∂X)ᵀ K⁻¹ ∂r/∂xᵀ u`` (:mod:`vares.analysis.erection_sensitivity`),
 and LSQR solves each step's least-squares problem. It stops when a step lowers ``J`` by less than
-``tolerance`` of it, or after ``iterations`` steps. Patterns stay one-to-one (a step that inverts
-a pattern cell is refused like one that raises ``J``).
+``tolerance`` of it, when nothing is left above round-off, or after ``optimise_iterations``
+steps. Patterns stay one-to-one (a step that inverts a pattern cell is refused like one that
+raises ``J``).
 """
 
 from __future__ import annotations
