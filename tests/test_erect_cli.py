@@ -266,3 +266,34 @@ def test_a_cut_takes_its_intended_prestress_per_cell_and_erect_reads_it_again(tm
     again = run("erect", out, "-f", "-q")
     assert again.exit_code == 0, again.stderr
     assert json.loads((out / "erect" / "erect.json").read_text())["stress"] == first["stress"]
+
+
+def test_a_cut_with_optimise_nests_the_optimised_pieces_once(tmp_path, monkeypatch):
+    """`vares cut --erect --optimise`: the pieces are nested once (they were nested before the
+    optimisation and again after it), from the patterns written (a piece's extent is its
+    pattern's with the allowances)."""
+    from vares.structures import cutting
+
+    nested, original = [], cutting.nest_pieces
+    monkeypatch.setattr(
+        cutting,
+        "nest_pieces",
+        lambda pieces, *a, **k: nested.append(pieces) or original(pieces, *a, **k),
+    )
+    mesh = vares.examples.hypar(size=6.0, rise=0.05, n=8)
+    source = tmp_path / "roof.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+    out = tmp_path / "cut"
+    flags = ["--fabric", "pes-pvc-type-2", "--prestress", "2,1.5", "--nest-time", "1"]
+    result = run(
+        "cut", source, "-o", out, "--roll-width", "2", *flags, "--erect", "--optimise", "-q"
+    )
+    assert result.exit_code == 0, result.stderr
+    assert len(nested) == 1
+    erected = json.loads((out / "erect" / "erect.json").read_text())
+    assert erected["optimisation"]["iterations"] >= 1
+    structure = json.loads((out / "structure.json").read_text())
+    first = structure["panels"][0]["name"]
+    pattern = meshio.read(out / first / "pattern.obj").points[:, :2]
+    ring = nested[0][0]  # the first piece's cut ring: its seam ring lies inside, allowance around
+    assert np.ptp(ring, axis=0).max() == pytest.approx(np.ptp(pattern, axis=0).max(), rel=0.05)

@@ -208,7 +208,7 @@ def _erect(outcome: JobOutcome, options, callback) -> None:
 def _optimise(outcome: JobOutcome, patterns: list[Pattern], options) -> None:
     """Patterns optimised for the erected structure in place of the job's (the erection of the
     VaReS patterns kept beside it)."""
-    from ..analysis.erection_optimum import optimise_for_erection, optimised_results
+    from ..analysis.erection_optimum import optimise_for_erection
 
     job = outcome.job
     optimum = optimise_for_erection(
@@ -217,11 +217,26 @@ def _optimise(outcome: JobOutcome, patterns: list[Pattern], options) -> None:
     outcome.optimum, outcome.erection = optimum, optimum.erected
     if not optimum.converged:
         outcome.warnings.append(f"the patterns were not optimised: {optimum.reason}")
-        return
+    else:
+        _take_patterns(outcome, optimum)
+    if outcome.cut is not None:  # the pieces' outlines and the nest of the patterns cut
+        from ..structures.cutting import with_patterns
+
+        outcome.cut = with_patterns(outcome.cut, outcome.structure)
+
+
+def _optimising(job: Job) -> bool:
+    return job.erection is not None and job.erection.optimise
+
+
+def _take_patterns(outcome: JobOutcome, optimum) -> None:
+    """The optimised patterns in place of the job's (reports and seams of the new ones)."""
+    from ..analysis.erection_optimum import optimised_results
+
+    job = outcome.job
     results = optimised_results([p.result for p in outcome.panels], optimum)
-    source = Input(panels=[], units=outcome.units)
     for k, (panel, result) in enumerate(zip(outcome.panels, results, strict=True)):
-        fresh = _panel(job, source, panel.name, panel.mesh, result)
+        fresh = _panel(job, outcome.units, panel.name, panel.mesh, result)
         panel.result, panel.compensation, panel.warnings = (
             result,
             fresh.compensation,
@@ -231,10 +246,6 @@ def _optimise(outcome: JobOutcome, patterns: list[Pattern], options) -> None:
             outcome.structure.results[k] = result
     if outcome.structure is not None:
         outcome.structure.seam_reports = _seam_reports_after(outcome.structure)
-    if outcome.cut is not None:  # the pieces' outlines and the nest of the new patterns
-        from ..structures.cutting import with_patterns
-
-        outcome.cut = with_patterns(outcome.cut, outcome.structure)
 
 
 def _seam_reports_after(structure):
@@ -333,11 +344,11 @@ def run_erection(
 
 
 def _panel(
-    job: Job, source: Input, name: str, mesh: SurfaceMesh, result: PatternResult
+    job: Job, units: str, name: str, mesh: SurfaceMesh, result: PatternResult
 ) -> PanelOutcome:
     slack = job.prestress.slack_threshold
     report = compensation_report(result, slack) if result.converged else None
-    panel = PanelOutcome(name, mesh, result, report, job.directory, source.units)
+    panel = PanelOutcome(name, mesh, result, report, job.directory, units)
     panel.warnings = pattern_warnings(result, report)
     return panel
 
@@ -353,7 +364,7 @@ def _solve_one(job, source: Input, material, options, callback) -> JobOutcome:
         callback=callback,
         initial_guess=source.initial_pattern,
     )
-    patterned = _panel(job, source, panel.name, panel.mesh, result)
+    patterned = _panel(job, source.units, panel.name, panel.mesh, result)
     if job.drape is not None:
         from ..analysis.drape import drape_ply
         from ..geometry.orientation import erected_warp
@@ -383,7 +394,7 @@ def _solve_structure(job, source: Input, material, options, callback) -> JobOutc
         callback=callback,
     )
     pairs = zip(source.panels, structure.results, strict=True)
-    panels = [_panel(job, source, p.name, p.mesh, r) for p, r in pairs]
+    panels = [_panel(job, source.units, p.name, p.mesh, r) for p, r in pairs]
     too_wide = [
         f"{name} is {width:.4g} {source.units} wide across the warp, more than the roll width "
         f"{structure.structure_options.roll_width:g}"
@@ -424,9 +435,10 @@ def _solve_cut(job, source: Input, material, options, callback) -> JobOutcome:
         structure=job.structure,
         cutting=job.cut,
         callback=callback,
+        nest=not _optimising(job),  # nested once the patterns are optimised
     )
     pairs = zip(result.plan.panels, result.structure.results, strict=True)
-    panels = [_panel(job, source, p.name, p.mesh, r) for p, r in pairs]
+    panels = [_panel(job, source.units, p.name, p.mesh, r) for p, r in pairs]
     warnings = [
         f"{result.plan.panels[k].name} is {result.widths[k]:.6g} {source.units} wide across the "
         f"warp with its allowances; the roll ({job.cut.roll_width:g}) takes at most "

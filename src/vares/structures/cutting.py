@@ -142,14 +142,17 @@ def cut(
     structure: StructureOptions | None = None,
     cutting: CutOptions | None = None,
     callback: Callable[[IterationRecord], None] | None = None,
+    nest: bool = True,
     **settings: Any,
 ) -> CutResult:
     """Cut a surface into strips of roll width, pattern them with matched seams and nest them.
 
     ``roll_width`` (an option, below) is in the mesh's ``units``; ``allowance`` (the seam
     allowance) and the edge allowances are in ``dxf_units``, as on the cutter's drawing.
-    ``prestress`` is uniform or one row per cell of ``mesh`` (the membrane forces of a
-    form-finding run): each strip's cells take the rows of the cells they were cut from.
+    ``nest=False`` leaves the nest to a later :func:`with_patterns` (patterns that will change
+    before they are cut). ``prestress`` is uniform or one row per cell of ``mesh`` (the
+    membrane forces of a form-finding run): each strip's cells take the rows of the cells they
+    were cut from.
     ``lines`` are the user's cutting lines (polylines ``(k, 3)`` near the surface), given
     with ``seams = "curves"`` (a job names a file of them instead: option ``curves``). The
     warp runs along each strip unless ``warp_direction`` is given.
@@ -204,14 +207,14 @@ def cut(
             break
         # the flattened widths underestimated the patterns': ask the flattening for less
         target = max(plan.widths) * usable / max(widths) * (1.0 - 1e-3)
-    nest = _nest(outlines, widths, result, cutting, scale)
+    nested = _nest(outlines, widths, result, cutting, scale) if nest else None
     return CutResult(
         plan,
         result,
         outlines,
         widths,
         seam_lines(plan, result),
-        nest,
+        nested,
         cutting,
         mesh.area,
         units,
