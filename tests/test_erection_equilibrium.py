@@ -154,3 +154,17 @@ def test_where_slack_regions_leave_no_isolated_equilibrium_the_regularised_one_i
     assert 0 < law <= 1.01 * film + ctx.residual_tolerance
     assert result.to_dict()["regularised"] is True
     assert not vares.erect(taut_hypar()).regularised
+
+
+def test_an_erection_result_keeps_no_factorisation():
+    """The result keeps what the sensitivities need (problem, dof map, tolerances), not the last
+    tangent's factors: SuperLU's of the solve are freed with its solver."""
+    pattern = vares.solve(
+        vares.examples.hypar(n=6),
+        NeoHooke(E=600.0, nu=0.3),
+        prestress=2.0,
+        linear_solver="scipy-superlu",
+    )
+    result = vares.erect(pattern)
+    assert result.converged and result.linear_solver == "scipy-superlu"
+    assert result.context.linear_solver._lu is None

@@ -30,7 +30,7 @@ from ..solver.linear import get_solver
 from ..solver.newton import NewtonContext, describe_cells
 from ..solver.options import SolveOptions
 from ..solver.result import IterationRecord, PatternResult, StepRecord
-from ..solver.reuse import ETA_MAX, ETA_MAX_KINKED
+from ..solver.reuse import ETA_MAX, ETA_MAX_KINKED, ReusingSolver
 from ..solver.strategies import Attempt, follow_plan
 from .erection_fields import erection_statistics, membrane_forces, node_normals
 from .erection_model import Pattern, Structure, build_structure, patterns_of
@@ -266,6 +266,11 @@ def erect(
             problem, x, ctx, taut=not fields["state"].any(), film=regularised
         )
     normals, node_areas = node_normals(mesh)
+    solver_name = ctx.linear_solver.name
+    # the result keeps the dof map and tolerances, not the last tangent's factors (at 1M
+    # triangles a factorisation holds gigabytes): a fresh solver of the same kind
+    ctx.linear_solver = get_solver(solver_name)
+    ctx.systems = ReusingSolver(ctx.linear_solver)
     return ErectionResult(
         mesh=mesh,
         erected_points=x,
@@ -274,7 +279,7 @@ def erect(
         history=ctx.history,
         steps=ctx.steps,
         strategy=path,
-        linear_solver=ctx.linear_solver.name,
+        linear_solver=solver_name,
         elapsed=time.perf_counter() - started,
         options=options,
         material=material,
