@@ -206,3 +206,29 @@ def test_a_structure_is_optimised_with_its_seams_kept_matched():
     for result, pattern in zip(results, optimum.patterns, strict=True):
         np.testing.assert_array_equal(result.material_coordinates, pattern.material_coordinates)
         assert result.fields["det_F"].shape == (result.mesh.num_cells,)
+
+
+def test_an_optimised_pattern_that_laps_over_itself_is_refused(monkeypatch):
+    """The optimised patterns are checked for overlap like any pattern: one that is not
+    one-to-one is named (here a pattern with a cell turned over), and the optimisation then
+    returns the starting patterns, not converged."""
+    from vares.analysis import erection_optimum
+
+    solved = _taut_hypar()
+    good = Pattern.of(solved, "sail")
+    assert erection_optimum._overlapping([good]) is None
+    folded = solved.material_coordinates.copy()
+    a, b = solved.mesh.cells["triangle"][40][:2]
+    folded[[a, b]] = folded[[b, a]]
+    message = erection_optimum._overlapping(
+        [dataclasses.replace(good, material_coordinates=folded)]
+    )
+    assert message is not None and message.startswith(
+        "sail: the optimised pattern is not one-to-one"
+    )
+    monkeypatch.setattr(erection_optimum, "_overlapping", lambda patterns: "sail: laps over itself")
+    optimum = optimise_for_erection(solved)
+    assert not optimum.converged and optimum.reason == "sail: laps over itself"
+    np.testing.assert_array_equal(
+        optimum.patterns[0].material_coordinates, solved.material_coordinates
+    )

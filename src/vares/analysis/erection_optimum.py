@@ -261,6 +261,9 @@ def optimise_for_erection(
         converged = True  # every step taken lowered the objective: the patterns are usable
     if not converged:
         reason = "no step lowers the objective"
+    overlap = _overlapping(current)
+    if overlap is not None:  # a pattern that laps over itself is no cutting pattern
+        current, erected, converged, reason = patterns, first, False, overlap
     return OptimisedPatterns(
         current,
         first,
@@ -272,6 +275,18 @@ def optimise_for_erection(
         shape_bound,
         elapsed=time.perf_counter() - started,
     )
+
+
+def _overlapping(patterns: list[Pattern]) -> str | None:
+    """Why an optimised pattern is not one-to-one (it laps over itself), or None."""
+    from ..geometry.injectivity import pattern_overlap
+
+    for pattern in patterns:
+        overlap = pattern_overlap(pattern.mesh, pattern.material_coordinates)
+        if overlap is not None:
+            where = overlap.describe(pattern.mesh)
+            return f"{pattern.name}: the optimised pattern is not one-to-one: {where}"
+    return None
 
 
 def _lsqr(op, model, mu):
