@@ -12,7 +12,8 @@ drape. The **ply-stack check** (the seed's Fig. 11) erects the blank of drape A 
 drape B: a blank cut for A from a roll turned for B, i.e. B's yarns at ``θ_B − θ_A`` in A's
 pattern frame (where A's warp runs along +x). It reports per pair the area whose warp or fill is
 compressed (shortened by more than ``compression_strain``), the largest yarn compression and the
-deviation of the erected yarns from B's own drape.
+deviation of the erected yarns from B's own drape (:mod:`.laminate_pairs`). Where each ply lies
+on the mould (its region's cells and mesh, its warp at the seed) is :mod:`.laminate_regions`.
 """
 
 from __future__ import annotations
@@ -26,8 +27,6 @@ from typing import Any
 import numpy as np
 
 from ..analysis.drape import PlyDrape, drape_ply
-from ..analysis.evaluate import PatternEvaluation, evaluate
-from ..geometry.elements import ELEMENTS, inverse
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..options import OptionsError, split_settings, takes_options
@@ -35,6 +34,8 @@ from ..parallel import process_pool
 from ..solver.api import solve
 from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
+from .laminate_pairs import PAIR_VALUES, PairCheck, blank_used_for, draped_yarns, pair_check
+from .laminate_regions import cell_blocks, ply_warp, region_cells, submesh
 
 __all__ = [
     "PAIR_VALUES",
@@ -88,52 +89,6 @@ class Laminate:
         orders = [p.options.drop_off for p in self.plies if p.options.drop_off is not None]
         if len(set(orders)) != len(orders):
             raise OptionsError("drop_off", f"must differ from ply to ply; got {orders}")
-
-
-def ply_warp(
-    mesh: SurfaceMesh, seed: np.ndarray, reference: np.ndarray, orientation: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """The warp ``(3,)`` (unit) of a ply at ``seed`` ``(3,)`` and the mould's unit normal there
-    ``(3,)``: ``reference`` ``(3,)`` projected onto the tangent plane at the seed, turned by
-    ``orientation`` degrees counter-clockwise about the normal. The normal is the area-weighted
-    normal of the cells round the mould node nearest the seed."""
-    seed = np.asarray(seed, dtype=float)
-    node = int(np.argmin(np.linalg.norm(mesh.points - seed, axis=1)))
-    vectors = mesh.area_vectors()
-    around = np.concatenate([np.any(c == node, axis=1) for c in mesh.cells.values()])
-    normal = vectors[around].sum(axis=0)
-    normal /= np.linalg.norm(normal)
-    reference = np.asarray(reference, dtype=float)
-    tangent = reference - (reference @ normal) * normal
-    if np.linalg.norm(tangent) < 1e-6 * np.linalg.norm(reference):
-        raise OptionsError(
-            "reference", "is normal to the mould at the seed: it gives no direction there"
-        )
-    tangent /= np.linalg.norm(tangent)
-    angle = np.radians(orientation)
-    warp = np.cos(angle) * tangent + np.sin(angle) * np.cross(normal, tangent)
-    return warp / np.linalg.norm(warp), normal
-
-
-def draped_yarns(
-    mesh: SurfaceMesh, coordinates: np.ndarray, warp: np.ndarray, fill: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The erected warp and fill ``(m, 3)`` per cell (unit, global cell order) of the pattern
-    ``coordinates`` ``(n, 2)`` with the yarn directions ``warp``, ``fill`` ``(2,)`` of the pattern
-    plane: ``F Φ`` averaged over the cell's quadrature points (pattern-area weights), normalised."""
-    out = []
-    for phi in (np.asarray(warp, dtype=float), np.asarray(fill, dtype=float)):
-        blocks = []
-        for cell_type, cells in mesh.cells.items():
-            element = ELEMENTS[cell_type]
-            j = element.jacobians(mesh.points, cells)
-            J = element.jacobians(coordinates, cells)
-            erected = np.einsum("mqik,mqkl,l->mqi", j, inverse(J), phi)
-            weight = np.linalg.det(J) * element.quadrature_weights
-            mean = np.einsum("mq,mqi->mi", weight, erected)
-            blocks.append(mean / np.linalg.norm(mean, axis=1)[:, None])
-        out.append(np.vstack(blocks))
-    return out[0], out[1]
 
 
 @dataclass
@@ -205,47 +160,6 @@ class PlyDrapeResult:
         return data
 
 
-@dataclass(frozen=True)
-class PairCheck:
-    """The blank of drape ``blank`` erected with the yarns of drape ``ply`` (their labels).
-
-    ``compressed_area_fraction``: the share of the 3D area whose warp or fill is shortened by
-    more than the threshold; ``warp_compressed_fraction``, ``fill_compressed_fraction``: of each
-    yarn alone; ``largest_compression``: the largest yarn shortening (strain, 1 − stretch; 0
-    when none is shorter); ``min_yarn_stress``: the most compressive Cauchy yarn stress;
-    ``mean_deviation``, ``max_deviation``: the angle (degrees, area-weighted mean and largest)
-    between the erected warp and the warp of ``ply``'s own drape; ``energy``: of the erection.
-    ``checked`` is False (and the numbers NaN) when the two cover different cells.
-    """
-
-    blank: str
-    ply: str
-    checked: bool
-    compressed_area_fraction: float = np.nan
-    warp_compressed_fraction: float = np.nan
-    fill_compressed_fraction: float = np.nan
-    largest_compression: float = np.nan
-    min_yarn_stress: float = np.nan
-    mean_deviation: float = np.nan
-    max_deviation: float = np.nan
-    energy: float = np.nan
-
-    def summary(self) -> dict[str, Any]:
-        return dict(self.__dict__)
-
-
-#: The numbers of a :class:`PairCheck` that the pair matrices show.
-PAIR_VALUES = (
-    "compressed_area_fraction",
-    "warp_compressed_fraction",
-    "fill_compressed_fraction",
-    "largest_compression",
-    "min_yarn_stress",
-    "mean_deviation",
-    "max_deviation",
-)
-
-
 @dataclass
 class LaminateResult:
     """A draped laminate: ``drapes`` (one per distinct ply, in the order of their first ply),
@@ -313,45 +227,6 @@ class LaminateResult:
 def _listed(matrix: np.ndarray) -> list[list[float | None]]:
     """A matrix as nested lists, NaN (a pair not checked) as ``None`` (JSON's null)."""
     return [[float(v) if np.isfinite(v) else None for v in row] for row in matrix]
-
-
-def _region_cells(ply: PlyOptions, cell_data: Mapping[str, np.ndarray], num_cells: int):
-    if ply.region is None:
-        return np.arange(num_cells)
-    if ply.region not in cell_data:
-        known = ", ".join(cell_data) or "none"
-        raise OptionsError(
-            "region", f"of ply {ply.name!r} names no cell field of the mould (it has: {known})"
-        )
-    values = np.asarray(cell_data[ply.region], dtype=float).reshape(num_cells, -1)[:, 0]
-    chosen = values != 0 if ply.region_value is None else np.isclose(values, ply.region_value)
-    cells = np.flatnonzero(chosen)
-    if not cells.size:
-        raise OptionsError("region", f"of ply {ply.name!r} holds no cell of the mould")
-    return cells
-
-
-def _blocks(mesh: SurfaceMesh, cells: np.ndarray) -> dict[str, np.ndarray]:
-    """The node indices of the given global cells, by cell type."""
-    blocks, start = {}, 0
-    for cell_type, block in mesh.cells.items():
-        mine = cells[(cells >= start) & (cells < start + len(block))] - start
-        if mine.size:
-            blocks[cell_type] = block[mine]
-        start += len(block)
-    return blocks
-
-
-def _submesh(mesh: SurfaceMesh, cells: np.ndarray) -> tuple[SurfaceMesh, np.ndarray]:
-    """The mesh of the given global cells and its nodes' indices on ``mesh``."""
-    if len(cells) == mesh.num_cells:
-        return mesh, np.arange(mesh.num_points)
-    blocks = _blocks(mesh, cells)
-    nodes = np.unique(np.concatenate([b.ravel() for b in blocks.values()]))
-    index = np.full(mesh.num_points, -1)
-    index[nodes] = np.arange(len(nodes))
-    sub = SurfaceMesh(mesh.points[nodes], {t: index[b] for t, b in blocks.items()})
-    return sub, nodes
 
 
 def _drape_one(task: dict[str, Any]) -> dict[str, Any]:
@@ -431,11 +306,11 @@ def drape_laminate(
     ply_drape: dict[str, tuple] = {}
     for ply in laminate.plies:
         o = ply.options
-        cells = _region_cells(o, cell_data, mesh.num_cells)
+        cells = region_cells(o, cell_data, mesh.num_cells)
         if o.seed is not None:
             seed = np.asarray(o.seed, dtype=float)
         elif len(cells) < mesh.num_cells:
-            blocks = _blocks(mesh, cells).values()
+            blocks = cell_blocks(mesh, cells).values()
             region = points[np.unique(np.concatenate([b.ravel() for b in blocks]))]
             target = region.mean(axis=0) if options.seed is None else default_seed
             seed = region[np.argmin(np.linalg.norm(region - target, axis=1))]
@@ -446,7 +321,7 @@ def drape_laminate(
         if key in groups:
             groups[key]["plies"].append(o.name)
             continue
-        sub, nodes = _submesh(mesh, cells)
+        sub, nodes = submesh(mesh, cells)
         warp, normal = ply_warp(sub, seed, np.asarray(options.reference), o.orientation)
         kinematic = None
         if options.kinematic:
@@ -489,7 +364,7 @@ def drape_laminate(
             callback(drape)
     labels = {key: g["label"] for key, g in groups.items()}
     pairs = {
-        (a.label, b.label): _pair_check(a, b, options.compression_strain)
+        (a.label, b.label): pair_check(a, b, options.compression_strain)
         for a in drapes
         for b in drapes
     }
@@ -544,65 +419,4 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
             kinematic.drape.shear_angle if kinematic else np.full(len(cells), np.nan)
         ),
         seconds=outcome["seconds"],
-    )
-
-
-def _angle_of(vector: np.ndarray) -> float:
-    return float(np.degrees(np.arctan2(vector[1], vector[0])))
-
-
-def blank_used_for(blank: PlyDrapeResult, ply: PlyDrapeResult) -> PatternEvaluation:
-    """The blank of ``blank`` erected with the material and yarns of ``ply``: ``ply``'s yarns at
-    ``θ_ply − θ_blank`` in the blank's pattern frame (:func:`vares.evaluate`; its per-cell
-    ``fields`` are those of ``blank.mesh``). Both must cover the same cells."""
-    if not np.array_equal(blank.cells, ply.cells):
-        raise ValueError(f"drapes {blank.label} and {ply.label} cover different cells")
-    pattern = blank.pattern
-    turn = ply.orientation - blank.orientation
-    own = ply.pattern.fibres
-    warp_angle = _angle_of(pattern.fibres.warp) + turn
-    fill_angle = warp_angle + _angle_of(own.fill) - _angle_of(own.warp)
-    return evaluate(
-        blank.mesh,
-        pattern.material_coordinates,
-        ply.material,
-        warp_angle=warp_angle,
-        fill_angle=fill_angle,
-    )
-
-
-def _pair_check(blank: PlyDrapeResult, ply: PlyDrapeResult, strain: float) -> PairCheck:
-    """The blank of ``blank`` erected with the yarns of ``ply`` (module docs)."""
-    if not np.array_equal(blank.cells, ply.cells):
-        return PairCheck(blank.label, ply.label, False)
-    pattern = blank.pattern
-    check = blank_used_for(blank, ply)
-    f = check.fields
-    area = f["surface_area"]
-    total = area.sum()
-    warp_short = f["warp_stretch"] < 1.0 - strain
-    fill_short = f["fill_stretch"] < 1.0 - strain
-    compression = 1.0 - np.minimum(f["warp_stretch"], f["fill_stretch"])
-    erected, _ = draped_yarns(
-        blank.mesh, pattern.material_coordinates, check.fibres.warp, check.fibres.fill
-    )
-    target = ply.warp[ply.cells]
-    deviation = np.degrees(
-        np.arctan2(
-            np.linalg.norm(np.cross(erected, target), axis=1),
-            np.abs(np.einsum("mi,mi->m", erected, target)),
-        )
-    )
-    return PairCheck(
-        blank.label,
-        ply.label,
-        True,
-        compressed_area_fraction=float(area[warp_short | fill_short].sum() / total),
-        warp_compressed_fraction=float(area[warp_short].sum() / total),
-        fill_compressed_fraction=float(area[fill_short].sum() / total),
-        largest_compression=float(max(compression.max(), 0.0)),
-        min_yarn_stress=float(min(f["warp_stress"].min(), f["fill_stress"].min())),
-        mean_deviation=float(area @ deviation / total),
-        max_deviation=float(deviation.max()),
-        energy=float(check.energy),
     )
