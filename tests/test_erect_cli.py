@@ -43,6 +43,20 @@ def test_pattern_then_erect_the_directory_matches_erect_in_the_same_run(tmp_path
     result = run("pattern", source, "-o", tmp_path / "q", *flags, "--erect", "-q")
     assert result.exit_code == 0, result.stderr
     same_run = json.loads((tmp_path / "q" / "erect" / "erect.json").read_text())
+    # summary.json says the erection beside the design shape (erect.json has the whole of it)
+    told = json.loads((tmp_path / "q" / "summary.json").read_text())["erection"]
+    assert told["converged"] and not told["optimised"] and told["file"] == "erect/erect.json"
+    assert set(told["states"]) == {"design_shape", "erected"}
+    assert told["states"]["erected"]["deviation"] == same_run["deviation"]
+    assert told["states"]["erected"]["area"] == same_run["erected_area"]
+    for yarn in ("warp", "fill"):
+        assert told["states"]["erected"]["stress"][yarn] == same_run["stress"][yarn]
+        assert (
+            told["states"]["design_shape"]["stress"][yarn]
+            == (same_run["design_shape"]["stress"][yarn])
+        )
+    assert told["states"]["design_shape"]["deviation"] == {"max": 0.0, "rms": 0.0}
+    assert "erection" not in json.loads((tmp_path / "p" / "summary.json").read_text())
     fabric = vares.materials.fabric("pes-pvc-type-2").material()
     api = vares.erect(
         vares.solve(vares.read_mesh(source), fabric, warp_direction=(1, 1, 0), prestress=(2, 1.5))
@@ -184,6 +198,15 @@ def test_optimise_writes_the_optimised_patterns_and_both_erections(tmp_path):
     assert rms[1] < rms[0]
     structure = json.loads((out / "structure.json").read_text())
     assert max(s["max_segment_mismatch_after"] for s in structure["seams"]) < 1e-9
+    # structure.json: the VaReS and the optimised patterns, on the design shape and erected
+    states = structure["erection"]["states"]
+    assert structure["erection"]["optimised"]
+    assert states["optimised_erected"]["stress"] == erected["stress"]
+    assert states["optimised_erected"]["deviation"] == erected["deviation"]
+    for key in ("stress", "wrinkled_area_fraction", "slack_area_fraction"):
+        assert states["vares_erected"][key] == optimisation["start_erected"][key]
+    assert states["vares_erected"]["deviation"] == optimisation["start_erected"]["deviation"]
+    assert states["vares_design_shape"]["stress"]["warp"]["intended"] == pytest.approx(2.0)
     # the written patterns are the optimised ones: erected again, they give erect.json's forces
     again = run("erect", out, "-f", "-q")
     assert again.exit_code == 0, again.stderr

@@ -26,7 +26,9 @@ if TYPE_CHECKING:
 __all__ = [
     "ERECTION_FILES",
     "erected_pictures",
+    "erection_columns",
     "erection_comparison",
+    "erection_figures",
     "erection_files",
     "write_erection",
 ]
@@ -47,32 +49,74 @@ def _number(value: float, digits: int = 4) -> str:
     return f"{value:.{digits}g}"
 
 
+def erection_columns(
+    result: ErectionResult, optimum: OptimisedPatterns | None = None
+) -> dict[str, dict[str, object]]:
+    """The figures an erection is judged by, per state: the patterns on the design shape and
+    erected (with ``optimum``, the erection of optimised patterns: the VaReS patterns' on the
+    design shape and erected, then the optimised patterns' on the design shape and erected).
+    Each state: the stress statistics per yarn, the wrinkled and slack area fractions, the
+    normal deviation from the design (``max``, ``rms``; zero on the design shape) and the area."""
+    zero = {"max": 0.0, "rms": 0.0}
+
+    def state(erection: ErectionResult, design: bool) -> dict[str, object]:
+        return {
+            **erection.statistics(design=design),
+            "deviation": zero if design else erection.deviation(),
+            "area": erection.surface_area if design else erection.erected_area,
+        }
+
+    if optimum is None:
+        return {"design_shape": state(result, True), "erected": state(result, False)}
+    return {
+        "vares_design_shape": state(optimum.start, True),
+        "vares_erected": state(optimum.start, False),
+        "optimised_design_shape": state(result, True),
+        "optimised_erected": state(result, False),
+    }
+
+
+def erection_figures(
+    result: ErectionResult, units: str, optimum: OptimisedPatterns | None = None
+) -> dict[str, object]:
+    """What a run's ``summary.json`` or ``structure.json`` says of its erection (the whole of
+    it is in ``erect/erect.json``): whether it converged, the units and
+    :func:`erection_columns`."""
+    return {
+        "converged": result.converged,
+        "regularised": result.regularised,
+        "optimised": optimum is not None,
+        "units": units,
+        "file": "erect/erect.json",
+        "states": erection_columns(result, optimum),
+    }
+
+
+_TITLES = {
+    "design_shape": "on the design shape",
+    "erected": "after erection",
+    "vares_erected": "VaReS patterns, erected",
+    "optimised_design_shape": "optimised, on the design shape",
+    "optimised_erected": "optimised, erected",
+}
+
+
 def erection_comparison(
     result: ErectionResult, units: str, optimum: OptimisedPatterns | None = None
 ) -> tuple[list[str], list[tuple[str, ...]]]:
     """The figures an erection is judged by, column by column: on the design shape, after
     erection (with ``optimum``: the VaReS patterns' erection, then the optimised patterns'):
     ``(column titles, rows of (label, value per column))`` for the command line and reports."""
+    states = erection_columns(result, optimum)
+    order = (
+        ("design_shape", "erected")
+        if optimum is None
+        else ("optimised_design_shape", "vares_erected", "optimised_erected")
+    )
     columns = [
-        (
-            "optimised, on the design shape" if optimum is not None else "on the design shape",
-            result.statistics(design=True),
-            None,
-            result.surface_area,
-        )
+        (_TITLES[k], s, None if "design" in k else s["deviation"], s["area"])
+        for k, s in ((k, states[k]) for k in order)
     ]
-    if optimum is not None:
-        start = optimum.start
-        columns.append(
-            ("VaReS patterns, erected", start.statistics(), start.deviation(), start.erected_area)
-        )
-        columns.append(
-            ("optimised, erected", result.statistics(), result.deviation(), result.erected_area)
-        )
-    else:
-        columns.append(
-            ("after erection", result.statistics(), result.deviation(), result.erected_area)
-        )
     rows: list[tuple[str, ...]] = []
     for yarn in ("warp", "fill"):
         stats = [c[1]["stress"][yarn] for c in columns]

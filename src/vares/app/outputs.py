@@ -41,7 +41,7 @@ from ..io.summary import summary
 from ..structures.panels import width_across_warp
 from ..structures.seams import seam_marks
 from ..units import unit_factor
-from .erection_outputs import erection_files
+from .erection_outputs import erection_figures, erection_files
 from .inputs import Input, safe_name
 from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
@@ -177,6 +177,8 @@ def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | No
             if shear is None
             else {"against_pattern": panel.drape.comparison(shear, panel.mesh.cell_areas())}
         )
+    if job.structure is None and outcome.erection is not None:
+        data["erection"] = erection_figures(outcome.erection, outcome.units, outcome.optimum)
     _write(panel, "summary.json", lambda p: write_json(p, data))
 
 
@@ -331,6 +333,8 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
         from .cut_outputs import cutting_details
 
         data["cutting"] = cutting_details(outcome)
+    if outcome.erection is not None:
+        data["erection"] = erection_figures(outcome.erection, outcome.units, outcome.optimum)
     write_json(directory / "structure.json", data)
     outcome.files.append(directory / "structure.json")
 
