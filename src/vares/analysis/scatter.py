@@ -1,11 +1,18 @@
 """The scatter of a fabric's compensation values carried into a panel's pattern.
 
 The compensation values of a batch scatter from specimen to specimen (docs/fabrics.md). A
-pattern compensated by their mean is one of the patterns the batch allows; :func:`pattern_band`
-solves the panel again with the warp and fill values at their mean ± ``sigmas`` standard
-deviations (the four corners) and reports, for the pattern's length along the warp, its width
-along the fill, its boundary length and its area, the value of the mean pattern and the
-smallest and largest over the corners, and how far any node moves (after the best rigid fit).
+pattern compensated by their mean is one of the patterns the batch allows.
+
+- :func:`pattern_band` solves the panel again with the warp and fill values at their mean ±
+  ``sigmas`` standard deviations (the four corners) and reports, for the pattern's length along
+  the warp, its width along the fill, its boundary length and its area, the value of the mean
+  pattern and the smallest and largest over the corners, and how far any node moves (after the
+  best rigid fit).
+- :func:`compensation_samples` draws random compensation values from their scatter (independent
+  normal warp and fill values: a batch of a few specimens says nothing of their correlation) and
+  :class:`Band` gathers any named figures of the samples (:class:`ScatterOptions`: how many
+  samples, which seed, how many standard deviations the band spans). The solves themselves are
+  :func:`vares.app.fabric_band.fabric_band`'s, which also erects the patterns.
 """
 
 from __future__ import annotations
@@ -16,13 +23,24 @@ from itertools import product
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
+from ..materials.anisotropic import OrthotropicStVenantKirchhoff
 from ..materials.base import MaterialError
 from ..materials.compensation_law import compensating_law
 from ..materials.presets import FabricPreset
+from ..options import Options, option
 from ..solver.api import solve
 from ..solver.result import PatternResult
 
-__all__ = ["PatternBand", "pattern_band", "pattern_dimensions"]
+__all__ = [
+    "Band",
+    "PatternBand",
+    "ScatterOptions",
+    "check_scatter",
+    "compensation_samples",
+    "pattern_band",
+    "pattern_dimensions",
+    "sample_law",
+]
 
 #: The dimensions a band gives (pattern units; area in units²).
 DIMENSIONS = ("warp_length", "fill_length", "boundary_length", "area")
@@ -72,12 +90,138 @@ def pattern_dimensions(result: PatternResult) -> dict[str, float]:
     }
 
 
+@dataclass(frozen=True)
+class ScatterOptions(Options):
+    """How the scatter of a fabric's compensation values is sampled and reported."""
+
+    title = "scatter option"
+
+    samples: int = option(
+        16,
+        "int",
+        "Random samples of the compensation values, each solved (and erected) on its own.",
+        section="scatter",
+        minimum=1,
+    )
+    sigmas: float = option(
+        2.0,
+        "float",
+        "Half-width of the band reported, in standard deviations of the samples' figures.",
+        section="scatter",
+        minimum=0,
+    )
+    seed: int = option(
+        0,
+        "int",
+        "Seed of the random samples: the same seed draws the same samples.",
+        section="scatter",
+        minimum=0,
+    )
+
+
+def compensation_samples(
+    fabric: FabricPreset, samples: int, seed: int = 0
+) -> list[tuple[float, float]]:
+    """``samples`` (warp, fill) compensation values (mm/mm) drawn from independent normal
+    distributions with the fabric's means and standard deviations. Raises
+    :class:`MaterialError` for a fabric without measured compensation values, or when a draw is
+    not a positive strain (a scatter too wide for a normal distribution)."""
+    c = fabric.compensation
+    if c is None:
+        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    z = np.random.default_rng(seed).standard_normal((int(samples), 2))
+    drawn = [(c.warp + a * c.warp_std, c.fill + b * c.fill_std) for a, b in z]
+    if any(w <= 0 or f <= 0 for w, f in drawn):
+        raise MaterialError(
+            f"fabric {fabric.name!r}: a sample of its compensation values is not a positive "
+            f"strain (warp {c.warp:.3g} ± {c.warp_std:.3g}, fill {c.fill:.3g} ± {c.fill_std:.3g})"
+        )
+    return [(float(w), float(f)) for w, f in drawn]
+
+
+def sample_law(fabric: FabricPreset, warp: float, fill: float) -> OrthotropicStVenantKirchhoff:
+    """The law compensating by the values ``warp``, ``fill`` at the fabric's measured prestress,
+    with its ``nu12`` and ``G12`` (:func:`compensating_law`)."""
+    c = fabric.compensation
+    if c is None:
+        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    return compensating_law(warp, fill, c.prestress, fabric.nu12, fabric.G12)
+
+
+@dataclass(frozen=True)
+class Band:
+    """Named figures of a nominal case and of its samples.
+
+    ``nominal``: each figure of the nominal case (the mean values); ``samples``: the figure of
+    each sample, in order; ``sigmas``: the band's half-width in sample standard deviations. The
+    band of a figure is ``nominal ± sigmas · std``.
+    """
+
+    nominal: dict[str, float]
+    samples: dict[str, tuple[float, ...]]
+    sigmas: float
+
+    @classmethod
+    def of(cls, nominal: dict[str, float], samples: list[dict[str, float]], sigmas: float) -> Band:
+        """The band of the figures ``nominal`` has, from one mapping per sample."""
+        return cls(
+            dict(nominal), {n: tuple(float(s[n]) for s in samples) for n in nominal}, float(sigmas)
+        )
+
+    @property
+    def names(self) -> list[str]:
+        return list(self.nominal)
+
+    def std(self, name: str) -> float:
+        """Sample standard deviation of a figure (0 for one sample)."""
+        values = np.asarray(self.samples[name])
+        # about the first sample: equal samples have a standard deviation of exactly 0
+        return float(np.std(values - values[0], ddof=1)) if len(values) > 1 else 0.0
+
+    def spread(self, name: str) -> float:
+        """Half-width of the band: ``sigmas`` standard deviations."""
+        return self.sigmas * self.std(name)
+
+    def to_dict(self) -> dict[str, dict[str, float]]:
+        """Per figure: nominal, mean, std, spread (± ``sigmas`` std), min and max of the samples."""
+        return {
+            name: {
+                "nominal": value,
+                "mean": float(np.mean(self.samples[name])),
+                "std": self.std(name),
+                "spread": self.spread(name),
+                "min": float(np.min(self.samples[name])),
+                "max": float(np.max(self.samples[name])),
+            }
+            for name, value in self.nominal.items()
+        }
+
+
 def _aligned(reference: np.ndarray, moving: np.ndarray) -> np.ndarray:
     """``moving`` after the proper 2D rigid motion that best fits it onto ``reference``."""
     a, b = reference.mean(axis=0), moving.mean(axis=0)
     u, _, vt = np.linalg.svd((moving - b).T @ (reference - a))
     d = np.sign(np.linalg.det(u @ vt))
     return (moving - b) @ (u @ np.diag([1.0, d]) @ vt) + a
+
+
+def check_scatter(fabric: FabricPreset) -> None:
+    """Raise :class:`MaterialError` for a fabric without measured compensation values or
+    without their scatter (both standard deviations 0, as from a single specimen): its band
+    would be the mean pattern alone."""
+    c = fabric.compensation
+    if c is None:
+        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    if c.warp_std == 0 and c.fill_std == 0:
+        origin = (
+            "warp_std and fill_std are 0 or not given"
+            if c.specimens is None or c.specimens > 1
+            else f"the values of {c.specimens} specimen"
+        )
+        raise MaterialError(
+            f"fabric {fabric.name!r} has no scatter of its compensation values ({origin}): "
+            "its band would be the mean pattern alone; fit two or more compensation records"
+        )
 
 
 def pattern_band(
@@ -97,19 +241,8 @@ def pattern_band(
     :class:`MaterialError` for a fabric without measured compensation values or without their
     scatter (both standard deviations 0, as from a single specimen).
     """
+    check_scatter(fabric)
     c = fabric.compensation
-    if c is None:
-        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
-    if c.warp_std == 0 and c.fill_std == 0:
-        origin = (
-            "warp_std and fill_std are 0 or not given"
-            if c.specimens is None or c.specimens > 1
-            else f"the values of {c.specimens} specimen"
-        )
-        raise MaterialError(
-            f"fabric {fabric.name!r} has no scatter of its compensation values ({origin}): "
-            "its band would be the mean pattern alone; fit two or more compensation records"
-        )
     if not (np.isfinite(sigmas) and sigmas >= 0):
         raise ValueError(f"sigmas must be a number ≥ 0; got {sigmas!r}")
     load = c.prestress if prestress is None else prestress

@@ -29,6 +29,7 @@ __all__ = [
     "compensating_law",
     "compensation_values",
     "law_compensation",
+    "strains_per_cycle",
 ]
 
 
@@ -95,6 +96,37 @@ def compensation_values(
         len(chosen),
         record.source,
     )
+
+
+def strains_per_cycle(
+    record: BiaxialRecord, prestress: tuple[float, float], *, tolerance: float | None = None
+) -> list[tuple[int, float, float]]:
+    """The warp and fill strains (mm/mm) at the prestress before each load cycle and after the
+    last: ``(k, warp, fill)`` with ``k`` the number of cycles done (0 before the first), at the
+    cycles' troughs where the force is within ``tolerance`` of the prestress (as in
+    :func:`compensation_values`). How the compensation grows over the cycles; empty when the
+    record has no cycles."""
+    target = np.asarray(prestress, dtype=float)
+    if tolerance is None:
+        tolerance = max(0.05 * float(target.max()), 0.05)
+    try:
+        cycles = find_cycles(record)
+    except RecordError:
+        return []
+    near = np.all(np.abs(record.force - target) <= tolerance, axis=1)
+    # each cycle starts where the force leaves its trough: the trough is the last sample at the
+    # prestress before that (after the previous cycle's peak)
+    bounds = [(0, cycles[0].start)] + [
+        (c.peak, cycles[k + 1].start if k + 1 < len(cycles) else c.end)
+        for k, c in enumerate(cycles)
+    ]
+    out = []
+    for k, (low, i) in enumerate(bounds):
+        at = np.flatnonzero(near[low : i + 1])
+        if at.size:
+            j = low + int(at[-1])
+            out.append((k, float(record.strain[j, 0]), float(record.strain[j, 1])))
+    return out
 
 
 def _flat_stationarity(

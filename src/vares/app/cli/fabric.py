@@ -2,13 +2,14 @@
 band of a panel's pattern under the scatter of the fabric's compensation values
 (docs/fabrics.md)."""
 
+import inspect
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from .common import console, guarded
-from .flags import InputError
+from .flags import InputError, flag_name, option_parameter, with_flags
 
 if TYPE_CHECKING:  # the engine is imported when a command runs
     from ...materials.fitting import FabricFit
@@ -89,6 +90,13 @@ def fit(
             "load ratio into this folder (PNG)."
         ),
     ] = None,
+    report: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also write the fit's HTML report here: measured against fitted per load "
+            "ratio, the residuals, the compensation per cycle and the tables."
+        ),
+    ] = None,
     force: Annotated[
         bool, typer.Option("--force", "-f", help="Overwrite the output file.")
     ] = False,
@@ -118,7 +126,9 @@ def fit(
                 "--compensate-by measured needs --prestress: the compensation values are read "
                 "at the prestress the compensation records (EN 17117-2) hold"
             )
-        check_writable([output], force)
+        if report is not None and report.suffix.lower() not in (".html", ".htm"):
+            raise InputError(f"--report must end in .html; got {report}")
+        check_writable([output] if report is None else [output, report], force)
         if G12 is not None:
             if not G12 > 0:
                 raise InputError(f"--G12 must be positive; got {G12:g}")
@@ -146,6 +156,11 @@ def fit(
         if plots is not None:
             figures = fabric_figures(fitted, records, plots)
             console.print(f"drew {len(figures)} figures in {plots}")
+        if report is not None:
+            from ..fabric_report import fit_report
+
+            write_text(report, fit_report(fitted, records))
+            console.print(f"wrote {report}")
 
     guarded(body)
 
@@ -233,7 +248,26 @@ def _show(fitted: "FabricFit") -> None:
         )
 
 
+def _scatter_flags() -> list[inspect.Parameter]:
+    """The flags of :class:`ScatterOptions`, from its declarations."""
+    from ...analysis.scatter import ScatterOptions
+
+    defaults = ScatterOptions.defaults()
+    return [
+        option_parameter(
+            name,
+            defaults[name],
+            {"int": int, "float": float}[spec.kind],
+            flag_name(name, spec),
+            help=f"{spec.help} ({spec.bounds()})",
+            panel="Scatter",
+        )
+        for name, spec in ScatterOptions.specs().items()
+    ]
+
+
 @fabric_app.command("band")
+@with_flags(_scatter_flags())
 def band(
     fabric_file: Annotated[
         Path,
@@ -241,11 +275,15 @@ def band(
             "--fabric", help="A fabric file with measured compensation values and their scatter."
         ),
     ],
-    mesh: Annotated[
-        Path | None, typer.Argument(metavar="MESH", help="The panel's surface mesh file.")
+    inputs: Annotated[
+        list[Path] | None,
+        typer.Argument(
+            metavar="MESH...",
+            help="The panel's surface mesh file, or one file per panel of a structure.",
+        ),
     ] = None,
     example: Annotated[
-        str | None, typer.Option(help="A shipped example surface instead of a file.")
+        str | None, typer.Option(help="A shipped example surface or structure instead.")
     ] = None,
     prestress: Annotated[
         str | None,
@@ -254,51 +292,131 @@ def band(
     warp_direction: Annotated[
         str | None, typer.Option(help="Warp direction 'x,y,z' on the surface.")
     ] = None,
-    sigmas: Annotated[
-        float, typer.Option(help="Half-width of the band in standard deviations.")
-    ] = 1.0,
+    match: Annotated[
+        bool,
+        typer.Option("--match/--no-match", help="Match the seams of a structure's panels."),
+    ] = True,
+    erect: Annotated[
+        bool,
+        typer.Option(
+            "--erect/--no-erect",
+            help="Erect the nominal patterns with each sample's fabric (the prestress range).",
+        ),
+    ] = True,
+    workers: Annotated[
+        int | None, typer.Option(help="Local worker processes for the samples (default: 1).")
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="A Dask scheduler (tcp://host:port) whose workers solve the samples."),
+    ] = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Write summary.json and report.html of the band into this folder.",
+        ),
+    ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", "-f", help="Overwrite the output files.")
+    ] = False,
+    **values: Any,
 ) -> None:
-    """The band of a panel's pattern under the scatter of its fabric's compensation values:
-    length along the warp, width along the fill, boundary length and area, at the mean values
-    and at mean ± SIGMAS standard deviations of warp and fill (docs/fabrics.md)."""
+    """The band of a panel's or a structure's patterns under the scatter of its fabric's
+    compensation values: the patterns solved for random samples of the values, and the
+    pattern dimensions, seam lengths and the erected prestress (the nominal patterns erected
+    with each sample's fabric) as nominal ± SIGMAS standard deviations (docs/fabrics.md)."""
 
     def body() -> None:
+        import json
+
         from rich.table import Table
 
-        from ...analysis.scatter import pattern_band
-        from ...geometry.examples import EXAMPLES
-        from ...io.meshes import read_mesh
+        from ...analysis.scatter import ScatterOptions, check_scatter
+        from ...geometry.examples import STRUCTURE_EXAMPLES
+        from ...io.files import check_writable, write_text
         from ...materials.presets import file_fabric
+        from ...options import OptionsError
+        from ...structures.options import StructureOptions
+        from ..fabric_band import fabric_band
+        from ..fabric_report import band_report
+        from ..inputs import load_input
+        from ..job import Job
+        from ..sections import InputOptions
 
-        if (mesh is None) == (example is None):
-            raise InputError("give one of a mesh file and --example")
-        if example is not None and example not in EXAMPLES:
-            raise InputError(f"--example must be one of {', '.join(EXAMPLES)}; got {example!r}")
-        surface = EXAMPLES[example]() if example is not None else read_mesh(mesh)
-        settings = {}
+        files = list(inputs or [])
+        if bool(files) == (example is not None):
+            raise InputError("give mesh files or --example, not both and not neither")
+        try:
+            scatter = ScatterOptions(**values)
+        except OptionsError as exc:
+            key = exc.key or ""
+            raise InputError(f"--{key.replace('_', '-')} {exc.problem}") from None
+        if workers is not None and workers < 1:
+            raise InputError(f"--workers must be at least 1; got {workers}")
+        if example is not None:
+            source, several = {"example": example}, example in STRUCTURE_EXAMPLES
+        elif len(files) == 1:
+            source, several = {"mesh": str(files[0].resolve())}, False
+        else:
+            source, several = {"meshes": tuple(str(f.resolve()) for f in files)}, True
+        structure = StructureOptions(match_seams=match) if several else None
+        loaded = load_input(Job(input=InputOptions(**source), structure=structure))
+        settings: dict[str, Any] = {"match_seams": match}
         if warp_direction is not None:
-            try:
-                direction = tuple(float(v) for v in warp_direction.split(","))
-            except ValueError:
-                direction = ()
-            if len(direction) != 3:
-                raise InputError(f"--warp-direction takes three numbers; got {warp_direction!r}")
-            settings["warp_direction"] = direction
+            settings["warp_direction"] = _vector(warp_direction, "--warp-direction")
         preset = file_fabric(fabric_file)
-        result = pattern_band(
-            surface, preset, _pair(prestress, "--prestress"), sigmas=sigmas, **settings
-        )
+        check_scatter(preset)
         c = preset.compensation
+        targets = [] if output is None else [output / "summary.json", output / "report.html"]
+        check_writable(targets, force)
+        result = fabric_band(
+            loaded.panels,
+            preset,
+            prestress=_pair(prestress, "--prestress"),
+            scatter=scatter,
+            erected=erect,
+            workers=workers,
+            scheduler=scheduler,
+            **settings,
+        )
         table = Table(
             "",
-            "mean values",
-            f"mean ± {sigmas:g} std",
+            "nominal",
+            f"± {scatter.sigmas:g} std",
+            "samples min … max",
             title=f"{preset.name}: warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, fill "
-            f"{100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % (pattern units)",
+            f"{100 * c.fill:.3f} ± {100 * c.fill_std:.3f} %, {scatter.samples} samples "
+            f"({loaded.units}; prestress: the nominal patterns erected with each sample's fabric)",
         )
-        for row in result.rows():
-            table.add_row(*row)
-        table.add_row("largest node movement", "", f"{result.node_deviation:.4g}")
+        for name, d in result.band.to_dict().items():
+            table.add_row(
+                name,
+                f"{d['nominal']:.6g}",
+                f"{d['spread']:.3g}",
+                f"{d['min']:.6g} … {d['max']:.6g}",
+            )
         console.print(table)
+        console.print(
+            f"nominal case {result.seconds['nominal']:.2f} s, {scatter.samples} samples "
+            f"{result.seconds['samples']:.2f} s"
+        )
+        if output is not None:
+            output.mkdir(parents=True, exist_ok=True)
+            summary = {**result.to_dict(), "units": loaded.units}
+            write_text(targets[0], json.dumps(summary, indent=2) + "\n")
+            write_text(targets[1], band_report(result, loaded.units))
+            console.print(f"wrote {targets[0]} and {targets[1]}")
 
     guarded(body)
+
+
+def _vector(text: str, flag: str) -> tuple[float, float, float]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3:
+        raise InputError(f"{flag} takes three numbers 'x,y,z'; got {text!r}")
+    return values[0], values[1], values[2]

@@ -1,0 +1,260 @@
+"""The band of a structure's patterns under the scatter of its fabric's compensation values.
+
+:func:`fabric_band` patterns the panels (seams matched, as ``vares panels`` does) compensated by
+the fabric's mean measured values — the nominal case — and again for each of
+``ScatterOptions.samples`` random draws of the values (:func:`vares.analysis.scatter.
+compensation_samples`). Each case gives the length along the warp, the width along the fill, the
+boundary length and the area of every panel's pattern, the length of every seam, and the
+**erected prestress**: the nominal patterns — the ones that are cut — erected
+(:func:`vares.erect`) with the fabric of the sample. That is the structure the client gets when
+the delivered fabric behaves like the sample; erecting each sample's own patterns with its own
+fabric would give back the intended prestress by construction and say nothing.
+
+The samples are independent solves: in this process, on ``workers`` local processes
+(:func:`vares.parallel.process_pool`, as a batch runs its jobs), or on the workers of a Dask
+scheduler.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..analysis.erection import ErectionResult, erect
+from ..analysis.erection_model import Pattern, patterns_of
+from ..analysis.options import ErectionOptions
+from ..analysis.scatter import (
+    Band,
+    ScatterOptions,
+    compensation_samples,
+    pattern_dimensions,
+    sample_law,
+)
+from ..materials.base import MaterialError
+from ..materials.presets import FabricPreset
+from ..parallel import process_pool
+from ..structures.matching import StructureResult, solve_structure
+from ..structures.panels import Panel
+
+__all__ = [
+    "FabricBand",
+    "SampleTask",
+    "fabric_band",
+    "map_samples",
+    "prestress_figures",
+    "solve_sample",
+    "structure_figures",
+]
+
+#: The erected prestress figures of a case (force per length).
+PRESTRESS_FIGURES = ("warp_mean", "warp_min", "warp_max", "fill_mean", "fill_min", "fill_max")
+
+
+def structure_figures(structure: StructureResult) -> dict[str, float]:
+    """Per panel its pattern's dimensions (:func:`pattern_dimensions`, named ``PANEL
+    dimension``, or the dimension alone for a single panel), and per seam its length in the
+    first panel's pattern (``seam FIRST|SECOND``; after matching both sides are equally long)."""
+    single = len(structure.panels) == 1
+    out: dict[str, float] = {}
+    for panel, result in zip(structure.panels, structure.results, strict=True):
+        for name, value in pattern_dimensions(result).items():
+            out[name if single else f"{panel.name} {name}"] = value
+    for report in structure.seam_reports:
+        out[f"seam {report.first}|{report.second}"] = float(report.length_first_after)
+    return out
+
+
+def prestress_figures(erection: ErectionResult) -> dict[str, float]:
+    """Area-weighted mean, smallest and largest erected membrane force of warp and fill."""
+    stress = erection.statistics()["stress"]
+    return {
+        f"prestress {yarn}_{kind}": float(stress[yarn][kind])
+        for yarn in ("warp", "fill")
+        for kind in ("mean", "min", "max")
+    }
+
+
+@dataclass(frozen=True)
+class SampleTask:
+    """One case: the panels solved with ``law`` (and ``settings``: solve and structure options
+    of :func:`vares.solve_structure`); with ``patterns``, those erected with ``law`` too."""
+
+    panels: tuple[Panel, ...]
+    law: Any
+    thickness: float
+    prestress: tuple[float, float]
+    settings: Mapping[str, Any]
+    patterns: tuple[Pattern, ...] | None = None
+    erection: ErectionOptions | None = None
+
+
+@dataclass(frozen=True)
+class SampleOutcome:
+    """What one case gave: its figures, whether its solve and erection converged (and why not),
+    and its time (s)."""
+
+    figures: dict[str, float]
+    converged: bool
+    reason: str | None
+    seconds: float
+
+
+def solve_sample(task: SampleTask) -> SampleOutcome:
+    """Solve one case (any process may run it)."""
+    started = time.perf_counter()
+    structure = solve_structure(
+        list(task.panels), task.law, task.thickness, prestress=task.prestress, **task.settings
+    )
+    figures = structure_figures(structure)
+    converged, reason = structure.converged, structure.reason
+    if task.patterns is not None and converged:
+        erected = erect(
+            list(task.patterns),
+            task.law,
+            task.thickness,
+            solver=structure.options,
+            options=task.erection,
+        )
+        figures.update(prestress_figures(erected))
+        converged, reason = erected.converged, erected.reason
+    return SampleOutcome(figures, converged, reason, time.perf_counter() - started)
+
+
+def map_samples(
+    function: Callable[[Any], Any],
+    tasks: Sequence[Any],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+) -> list[Any]:
+    """``function`` of every task, in order: here (``workers`` None or 1), on ``workers`` local
+    processes, or on the Dask scheduler at ``scheduler`` (``tcp://host:port``)."""
+    if scheduler is not None:
+        from dask.distributed import Client
+
+        with Client(scheduler, timeout="20s") as client:
+            return client.gather(client.map(function, list(tasks), pure=False))
+    if workers is None or workers <= 1:
+        return [function(t) for t in tasks]
+    with process_pool(workers) as pool:
+        return list(pool.map(function, tasks))
+
+
+@dataclass
+class FabricBand:
+    """A structure's patterns under the scatter of its fabric (module docs).
+
+    ``band``: every figure's nominal value and samples (:class:`Band`); ``cases``: the sampled
+    (warp, fill) compensation values; ``nominal``: the nominal structure and ``erection`` its
+    plain erection (None when not erected); ``seconds``: the nominal case's time and the
+    samples' total wall time.
+    """
+
+    fabric: FabricPreset
+    prestress: tuple[float, float]
+    options: ScatterOptions
+    band: Band
+    cases: list[tuple[float, float]]
+    nominal: StructureResult
+    erection: ErectionResult | None
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, object]:
+        """The band as ``summary.json`` keeps it."""
+        c = self.fabric.compensation
+        return {
+            "fabric": self.fabric.name,
+            "source": self.fabric.source,
+            "compensation": {
+                "prestress": list(c.prestress),
+                "warp": c.warp,
+                "fill": c.fill,
+                "warp_std": c.warp_std,
+                "fill_std": c.fill_std,
+                "specimens": c.specimens,
+            },
+            "prestress": list(self.prestress),
+            "scatter": self.options.to_dict(),
+            "sampled": "compensation values (independent normal warp and fill)",
+            "erected": "the nominal patterns erected with the fabric of each sample",
+            "panels": [p.name for p in self.nominal.panels],
+            "figures": self.band.to_dict(),
+            "samples": [{"warp": w, "fill": f} for w, f in self.cases],
+            "seconds": self.seconds,
+            "converged": True,
+        }
+
+
+def fabric_band(
+    panels: Sequence[Panel],
+    fabric: FabricPreset,
+    thickness: float = 1.0,
+    prestress: tuple[float, float] | None = None,
+    *,
+    scatter: ScatterOptions | None = None,
+    erection: ErectionOptions | None = None,
+    erected: bool = True,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    **settings: Any,
+) -> FabricBand:
+    """The nominal case and ``scatter.samples`` sampled cases of ``panels`` (module docs).
+
+    ``prestress`` defaults to the one the values were measured at; ``settings`` are options of
+    :func:`vares.solve_structure` (``warp_direction``, ``match_seams``, …); ``erected`` False
+    leaves out the erections. Raises :class:`MaterialError` for a fabric without measured
+    compensation values and when a case does not converge.
+    """
+    scatter = scatter or ScatterOptions()
+    c = fabric.compensation
+    if c is None:
+        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    load = tuple(float(v) for v in (c.prestress if prestress is None else prestress))
+    cases = compensation_samples(fabric, scatter.samples, scatter.seed)
+    panels = tuple(panels)
+    started = time.perf_counter()
+    law = sample_law(fabric, c.warp, c.fill)
+    nominal = solve_structure(list(panels), law, thickness, prestress=load, **settings)
+    if not nominal.converged:
+        raise MaterialError(f"the nominal patterns did not converge: {nominal.reason}")
+    figures = structure_figures(nominal)
+    patterns, plain = None, None
+    if erected:
+        patterns = tuple(patterns_of(nominal))
+        plain = erect(list(patterns), law, thickness, solver=nominal.options, options=erection)
+        if not plain.converged:
+            raise MaterialError(f"the nominal patterns did not erect: {plain.reason}")
+        figures.update(prestress_figures(plain))
+    nominal_seconds = time.perf_counter() - started
+    tasks = [
+        SampleTask(panels, sample_law(fabric, w, f), thickness, load, settings, patterns, erection)
+        for w, f in cases
+    ]
+    started = time.perf_counter()
+    outcomes = map_samples(solve_sample, tasks, workers=workers, scheduler=scheduler)
+    failed = [(k, o.reason) for k, o in enumerate(outcomes) if not o.converged]
+    if failed:
+        k, reason = failed[0]
+        w, f = cases[k]
+        raise MaterialError(
+            f"{len(failed)} of {len(cases)} samples did not converge; the first (warp "
+            f"{100 * w:.3f} %, fill {100 * f:.3f} %): {reason}"
+        )
+    return FabricBand(
+        fabric,
+        (load[0], load[1]),
+        scatter,
+        Band.of(figures, [o.figures for o in outcomes], scatter.sigmas),
+        cases,
+        nominal,
+        plain,
+        {
+            "nominal": nominal_seconds,
+            "samples": time.perf_counter() - started,
+            "per_sample_mean": float(np.mean([o.seconds for o in outcomes])),
+        },
+    )

@@ -1,0 +1,188 @@
+"""The HTML reports of a fabric: its fit to the biaxial test records (``vares fabric fit
+--report``) and the band of a structure's patterns under its scatter (``vares fabric band -o``).
+
+The fit's report shows, per stiffness record, the measured against the fitted force–strain
+response per load ratio and the loops of all cycles; the residual per load ratio; per
+compensation record its strains against time and the compensation per cycle; and the tables of
+the constants and compensation values. The band's report shows the sampled compensation values,
+every figure's band and the pattern dimensions with their band (docs/fabrics.md).
+"""
+
+from __future__ import annotations
+
+import html
+
+from ..io.fabric_plots import (
+    band_plot,
+    compensation_plot,
+    cycles_plot,
+    loops_plot,
+    ratios_plot,
+    residuals_plot,
+)
+from ..materials.biaxial import BiaxialRecord
+from ..materials.fitting import FabricFit
+from .fabric_band import FabricBand
+from .html_parts import figure, number, page, report_drawing, table
+
+__all__ = ["band_report", "fit_report"]
+
+
+def _record(records: list[BiaxialRecord], name: str, source: str) -> BiaxialRecord | None:
+    return next((r for r in records if (r.name, r.source) == (name, source)), None)
+
+
+def fit_report(fitted: FabricFit, records: list[BiaxialRecord]) -> str:
+    """The fit's report (one HTML page, figures embedded)."""
+    single = [
+        f"the {what} come from one specimen: their scatter is unknown (written as 0)"
+        for what, summary in (
+            ("constants", fitted.constants),
+            ("compensation values", fitted.compensation),
+        )
+        if summary is not None and summary.specimens == 1
+    ]
+    poor = [f.name for f in fitted.fits if f.linear_is_poor]
+    if poor:
+        single.append(
+            f"the linear law fits {', '.join(poor)} poorly (the nonlinear response leaves less "
+            "than two thirds of its residual): the constants are secant values over the range"
+        )
+    parts = page(fitted.name, f"Fabric fit: {fitted.name}", "fitted", single)
+    m, s = fitted.constants.mean, fitted.constants.std
+    rows = [
+        (
+            f.name,
+            f"{f.E_w:.1f} ± {f.standard_errors['E_w']:.1f}",
+            f"{f.E_f:.1f} ± {f.standard_errors['E_f']:.1f}",
+            f"{f.nu_wf:.3f} ± {f.standard_errors['nu_wf']:.3f}",
+            f"{f.nu_fw:.3f} ± {f.standard_errors['nu_fw']:.3f}",
+            f"{f.rms:.2e}",
+        )
+        for f in fitted.fits
+    ]
+    rows.append(
+        (
+            "mean ± std",
+            f"{m['E_w']:.1f} ± {s['E_w']:.1f}",
+            f"{m['E_f']:.1f} ± {s['E_f']:.1f}",
+            f"{m['nu_wf']:.3f} ± {s['nu_wf']:.3f}",
+            f"{m['nu_fw']:.3f} ± {s['nu_fw']:.3f}",
+            "",
+        )
+    )
+    parts.append("<h2>Elastic constants (MSAJ/M-02)</h2>")
+    parts.append(
+        table(
+            rows,
+            ["specimen", "E1 (kN/m)", "E2 (kN/m)", "nu12", "nu21", "rms residual"],
+            "constants",
+        )
+    )
+    parts.append(
+        f"<p>G12 = {fitted.G12:g} kN/m {html.escape(fitted.G12_source)} (not measured by "
+        "biaxial tests).</p>"
+    )
+    residuals = [
+        (f.name, r.label, f"{r.rms_warp:.2e}", f"{r.rms_fill:.2e}", r.samples)
+        for f in fitted.fits
+        for r in f.residuals
+    ]
+    parts.append(table(residuals, ["specimen", "load ratio", "rms warp", "rms fill", "samples"]))
+    with report_drawing():
+        for f in fitted.fits:
+            record = _record(records, f.name, f.source)
+            if record is None:
+                continue
+            labels = ", ".join(r.label for r in f.residuals)
+            parts.append(
+                figure(
+                    ratios_plot(record, f),
+                    f"{f.name}: measured and fitted per load ratio ({labels})",
+                    f"ratios-{f.name}",
+                )
+            )
+            parts.append(figure(loops_plot(record, f), f"{f.name}: all cycles", f"loops-{f.name}"))
+        parts.append(figure(residuals_plot(fitted.fits), "residual per load ratio", "residuals"))
+        if fitted.compensation is not None and fitted.prestress is not None:
+            p = fitted.prestress
+            parts.append(f"<h2>Compensation values (EN 17117-2) at {p[0]:g}/{p[1]:g} kN/m</h2>")
+            values = [
+                (c.name, f"{100 * c.warp:.3f} %", f"{100 * c.fill:.3f} %")
+                for c in fitted.compensations
+            ]
+            cm, cs = fitted.compensation.mean, fitted.compensation.std
+            values.append(
+                (
+                    "mean ± std",
+                    f"{100 * cm['warp']:.3f} ± {100 * cs['warp']:.3f} %",
+                    f"{100 * cm['fill']:.3f} ± {100 * cs['fill']:.3f} %",
+                )
+            )
+            law = fitted.law_compensation()
+            if law is not None:
+                values.append(("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %"))
+            parts.append(table(values, ["specimen", "warp", "fill"], "compensation"))
+            pairs = [
+                (record, c)
+                for c in fitted.compensations
+                if (record := _record(records, c.name, c.source)) is not None
+            ]
+            if pairs:
+                parts.append(figure(cycles_plot(pairs), "compensation per cycle", "cycles"))
+            for record, c in pairs:
+                parts.append(
+                    figure(
+                        compensation_plot(record, c),
+                        f"{c.name}: strains against time",
+                        f"compensation-{c.name}",
+                    )
+                )
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def band_report(band: FabricBand, units: str = "m") -> str:
+    """The band's report (one HTML page, the figure embedded)."""
+    c = band.fabric.compensation
+    scatter = band.options
+    parts = page(band.fabric.name, f"Pattern band: {band.fabric.name}", "converged", [])
+    parts.append("<h2>Fabric and samples</h2>")
+    parts.append(
+        f"<p>{html.escape(band.fabric.name)}: compensation values at "
+        f"{c.prestress[0]:g}/{c.prestress[1]:g} kN/m warp {100 * c.warp:.3f} ± "
+        f"{100 * c.warp_std:.3f} %, fill {100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % "
+        f"({c.specimens or '?'} specimens; {html.escape(band.fabric.source)}). "
+        f"{scatter.samples} samples (seed {scatter.seed}) of independent normal warp and fill "
+        f"values; the band is the nominal value ± {scatter.sigmas:g} sample standard "
+        "deviations. Prestress: the nominal patterns erected with the fabric of each sample "
+        f"(prestress {band.prestress[0]:g}/{band.prestress[1]:g}).</p>"
+    )
+    rows = [
+        (
+            name,
+            number(d["nominal"], 7),
+            f"± {number(d['spread'], 3)}",
+            f"{number(d['min'], 7)} … {number(d['max'], 7)}",
+        )
+        for name, d in band.band.to_dict().items()
+    ]
+    parts.append("<h2>Band</h2>")
+    parts.append(
+        table(
+            rows,
+            ["figure", "nominal", f"± {scatter.sigmas:g} std", "samples min … max"],
+            "band",
+        )
+    )
+    with report_drawing():
+        parts.append(
+            figure(band_plot(band.band, units), "pattern dimensions with their band", "band-plot")
+        )
+    seconds = band.seconds
+    parts.append(
+        f"<p>Nominal case {seconds.get('nominal', 0):.2f} s; {scatter.samples} samples "
+        f"{seconds.get('samples', 0):.2f} s.</p>"
+    )
+    parts.append("</body></html>")
+    return "\n".join(parts)
