@@ -14,53 +14,138 @@ Into the job's output folder (replaced as a whole when the run succeeds, see
   (:mod:`vares.io.orientations`); ``orientations.csv``: the same directions with element ids and
   the shear angle (those of the mechanical drape, or of the kinematic net with
   ``fe_directions = "kinematic"``);
-- ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields.
+- ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields;
+- ``plies/<ply>.dxf``: each ply's cutter file, net and extended (trim) boundaries, rosette and
+  label (:mod:`vares.io.ply_dxf`); ``nest.dxf``: every ply nested on the roll (with a
+  ``roll_width``);
+- ``plybook.html``: the ply book (:mod:`vares.app.ply_book`).
+
+``laminate.json`` holds per ply its areas, mass and producibility (``blanks``) and the nest
+(``nest``: roll width, length, yield; or why the plies were not nested).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..io.files import write_json, write_text
 from ..io.meshes import write_surface
 from ..io.orientations import PlyOrientations, write_abaqus_orientations, write_orientation_csv
+from ..io.ply_dxf import write_ply_dxf, write_ply_nest_dxf
 from ..structures.laminate import PAIR_VALUES, LaminateResult, PlyDrapeResult, drape_laminate
+from ..structures.laminate_blanks import PlyBlank, nest_plies, ply_blanks
+from ..structures.laminate_pairs import PAIR_TITLES
+from ..structures.nesting import RollNest
 from .inputs import load_input, safe_name
+from .job import JobError
 from .laminate_job import LaminateJob
+from .ply_book import ply_book, ply_producibility
 from .staging import OutputFolder
 
 __all__ = [
+    "LaminateRun",
     "file_label",
+    "laminate_cutting",
     "laminate_files",
     "laminate_markdown",
     "orientation_tables",
     "run_laminate",
+    "run_laminate_job",
     "write_laminate",
 ]
 
-#: What each pair matrix shows, and how its values are printed.
-PAIR_TITLES = {
-    "compressed_area_fraction": ("area with a compressed yarn", "%"),
-    "warp_compressed_fraction": ("area with compressed warp", "%"),
-    "fill_compressed_fraction": ("area with compressed fill", "%"),
-    "largest_compression": ("largest yarn compression (strain)", "%"),
-    "min_yarn_stress": ("most compressive yarn stress", "stress"),
-    "mean_deviation": ("mean deviation from the ply's own drape", "°"),
-    "max_deviation": ("largest deviation from the ply's own drape", "°"),
-}
-
 
 def laminate_files(job: LaminateJob, labels: list[str] | None = None) -> list[Path]:
-    """The files a run writes (``labels``: the distinct drapes' labels, if known)."""
+    """The files a run writes (``labels``: the distinct drapes' labels, if known); the nest's
+    only with a ``roll_width``. Two plies whose names make the same file name are refused."""
     directory = job.directory
     names = ["laminate.json", "laminate.md", "laminate.vtu", "orientations.inp", "orientations.csv"]
+    names += ["plybook.html"] + (["nest.dxf"] if job.laminate.roll_width is not None else [])
     paths = [directory / n for n in names]
+    dxf: dict[str, str] = {}
+    for ply in job.plies:
+        stem = safe_name(ply.name)
+        if stem.lower() in dxf:
+            raise JobError(
+                f"plies {dxf[stem.lower()]!r} and {ply.name!r} would write the same cutter file "
+                f"plies/{stem}.dxf: rename one"
+            )
+        dxf[stem.lower()] = ply.name
+        paths.append(directory / "plies" / f"{stem}.dxf")
     for label in labels or []:
         paths.append(directory / "patterns" / f"{file_label(label)}.vtu")
     return paths
+
+
+@dataclass
+class LaminateRun:
+    """A run of a laminate job: the draped laminate, each ply's blank (bottom first), the nest
+    on the roll (``None`` without a ``roll_width`` or when a blank is wider than the roll:
+    ``nest_error`` says so) and the mesh units."""
+
+    result: LaminateResult
+    blanks: list[PlyBlank]
+    nest: RollNest | None
+    nest_error: str | None
+    units: str
+
+    def summary(self) -> dict[str, Any]:
+        """``laminate.json``: the laminate's summary with ``blanks`` and ``nest``."""
+        blanks = []
+        for blank in self.blanks:
+            check = ply_producibility(self.result, blank.name)
+            blanks.append(
+                {
+                    "ply": blank.name,
+                    "net_area": blank.net_area,
+                    "trim_area": blank.trim_area,
+                    "surface_area": blank.surface_area,
+                    "trim_allowance": blank.allowance,
+                    "areal_weight": blank.areal_weight,
+                    "thickness": blank.thickness,
+                    "net_mass": blank.mass(blank.net_area, self.units),
+                    "trim_mass": blank.mass(blank.trim_area, self.units),
+                    "producibility": check.summary(),
+                }
+            )
+        nest: dict[str, Any] | None = None
+        if self.nest is not None:
+            nest = {
+                "roll_width": self.nest.roll_width,
+                "length": self.nest.length,
+                "net_area": self.nest.net_area,
+                "yield": self.nest.yield_,
+                "seconds": self.nest.elapsed,
+                "pieces": [
+                    {
+                        "ply": self.blanks[p.index].name,
+                        "rotation": p.rotation,
+                        "translation": list(p.translation),
+                    }
+                    for p in self.nest.pieces
+                ],
+            }
+        elif self.nest_error is not None:
+            nest = {"error": self.nest_error}
+        return self.result.summary() | {"units": self.units, "blanks": blanks, "nest": nest}
+
+
+def laminate_cutting(result: LaminateResult, units: str) -> LaminateRun:
+    """The blanks of a draped laminate and, with a ``roll_width``, their nest on the roll."""
+    blanks = ply_blanks(result)
+    options = result.laminate.options
+    nest, error = None, None
+    if options.roll_width is not None:
+        try:
+            nest = nest_plies(blanks, options.roll_width, time_limit=options.nest_time)
+        except ValueError as exc:  # a blank wider than the roll: the rest is still written
+            error = str(exc)
+    return LaminateRun(result, blanks, nest, error, units)
 
 
 def file_label(label: str) -> str:
@@ -180,30 +265,43 @@ def laminate_markdown(result: LaminateResult) -> str:
     return "\n".join(lines)
 
 
-def write_laminate(folder: OutputFolder, job: LaminateJob, result: LaminateResult) -> None:
+def write_laminate(folder: OutputFolder, job: LaminateJob, run: LaminateRun) -> None:
     """Write every file of :func:`laminate_files` into the staged folder."""
+    result = run.result
     paths = laminate_files(job, result.labels)
-    staged = {p.name: folder.staged(p) for p in paths[:5]}
-    write_json(staged["laminate.json"], result.summary())
+    for path in paths:
+        folder.staged(path).parent.mkdir(parents=True, exist_ok=True)
+    staged = {p.name: folder.staged(p) for p in paths if p.parent == job.directory}
+    write_json(staged["laminate.json"], run.summary())
     write_text(staged["laminate.md"], laminate_markdown(result))
     write_surface(staged["laminate.vtu"], result.mesh, None, _cell_vectors(result))
     tables = orientation_tables(result)
     write_abaqus_orientations(staged["orientations.inp"], tables)
     write_orientation_csv(staged["orientations.csv"], tables)
-    for drape, path in zip(result.drapes, paths[5:], strict=True):
-        target = folder.staged(path)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        write_surface(target, drape.mesh, drape.pattern.material_coordinates, drape.pattern.fields)
+    title = job.job.location.stem if job.job.location is not None else "laminate"
+    write_text(
+        staged["plybook.html"],
+        ply_book(result, run.blanks, run.nest, units=run.units, title=title),
+    )
+    if run.nest is not None:
+        write_ply_nest_dxf(staged["nest.dxf"], run.blanks, run.nest, units=run.units)
+    dxf = [p for p in paths if p.parent.name == "plies"]
+    for blank, path in zip(run.blanks, dxf, strict=True):
+        write_ply_dxf(folder.staged(path), blank, units=run.units)
+    vtu = [p for p in paths if p.parent.name == "patterns"]
+    for drape, path in zip(result.drapes, vtu, strict=True):
+        pattern = drape.pattern
+        write_surface(folder.staged(path), drape.mesh, pattern.material_coordinates, pattern.fields)
 
 
-def run_laminate(
+def run_laminate_job(
     job: LaminateJob,
     *,
     force: bool = False,
     workers: int | None = None,
     callback: Callable[[PlyDrapeResult], None] | None = None,
-) -> LaminateResult:
-    """Drape the job's laminate and write its files (module docs); the result."""
+) -> LaminateRun:
+    """Drape the job's laminate, cut and nest its plies and write its files (module docs)."""
     loaded = load_input(job.job)
     mesh = loaded.panels[0].mesh
     inputs = [job.job.path(p) for p in job.job.input.paths]
@@ -222,10 +320,22 @@ def run_laminate(
         solve_settings=job.job.solve.to_dict(),
         callback=callback,
     )
+    run = laminate_cutting(result, loaded.units)
     folder.start()
     try:
-        write_laminate(folder, job, result)
+        write_laminate(folder, job, run)
         folder.commit()
     finally:
         folder.discard()
-    return result
+    return run
+
+
+def run_laminate(
+    job: LaminateJob,
+    *,
+    force: bool = False,
+    workers: int | None = None,
+    callback: Callable[[PlyDrapeResult], None] | None = None,
+) -> LaminateResult:
+    """:func:`run_laminate_job`'s draped laminate."""
+    return run_laminate_job(job, force=force, workers=workers, callback=callback).result

@@ -80,6 +80,45 @@ class LaminateOptions(Options):
         positive=True,
     )
 
+    areal_weight: float | None = option(
+        None,
+        "float",
+        "Areal weight of the dry fabric, g/m², of every ply that names none: the ply book's "
+        "masses (of the flat blank; none when not given).",
+        section="laminate",
+        positive=True,
+    )
+    ply_thickness: float | None = option(
+        None,
+        "float",
+        "Cured thickness of every ply that names none, mm: the ply book's stacking sequence.",
+        section="laminate",
+        positive=True,
+    )
+    trim_allowance: float = option(
+        0.0,
+        "float",
+        "Excess round each ply's net boundary, mesh length units: the extended (trim) boundary "
+        "of the cutter files and the outline nested on the roll.",
+        section="laminate",
+        minimum=0.0,
+    )
+    roll_width: float | None = option(
+        None,
+        "float",
+        "Width of the fabric roll, mesh length units: every ply is nested on it with its warp "
+        "along the roll (default: no nest).",
+        section="laminate",
+        positive=True,
+    )
+    nest_time: float = option(
+        10.0,
+        "float",
+        "Time for nesting the plies on the roll (seconds).",
+        section="laminate",
+        positive=True,
+    )
+
     def check(self) -> None:
         if self.fe_directions == "kinematic" and not self.kinematic:
             raise OptionsError("fe_directions", "'kinematic' needs kinematic = true")
@@ -143,6 +182,21 @@ class PlyOptions(Options):
         "int",
         "Drop-off order: 1 for the ply that ends first, 2 the next, … (default: runs over the "
         "whole part).",
+        section="ply",
+        positive=True,
+    )
+
+    areal_weight: float | None = option(
+        None,
+        "float",
+        "Areal weight of the ply's dry fabric, g/m² (default: the laminate's).",
+        section="ply",
+        positive=True,
+    )
+    thickness: float | None = option(
+        None,
+        "float",
+        "Cured thickness of the ply, mm (default: the laminate's ply_thickness).",
         section="ply",
         positive=True,
     )

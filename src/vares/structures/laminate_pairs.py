@@ -21,7 +21,14 @@ from ..geometry.mesh import SurfaceMesh
 if TYPE_CHECKING:
     from .laminate import PlyDrapeResult
 
-__all__ = ["PAIR_VALUES", "PairCheck", "blank_used_for", "draped_yarns", "pair_check"]
+__all__ = [
+    "PAIR_TITLES",
+    "PAIR_VALUES",
+    "PairCheck",
+    "blank_used_for",
+    "draped_yarns",
+    "pair_check",
+]
 
 
 def draped_yarns(
@@ -88,6 +95,18 @@ PAIR_VALUES = (
 
 def _angle_of(vector: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(vector[1], vector[0])))
+
+
+#: What each pair matrix shows, and how its values are printed.
+PAIR_TITLES = {
+    "compressed_area_fraction": ("area with a compressed yarn", "%"),
+    "warp_compressed_fraction": ("area with compressed warp", "%"),
+    "fill_compressed_fraction": ("area with compressed fill", "%"),
+    "largest_compression": ("largest yarn compression (strain)", "%"),
+    "min_yarn_stress": ("most compressive yarn stress", "stress"),
+    "mean_deviation": ("mean deviation from the ply's own drape", "°"),
+    "max_deviation": ("largest deviation from the ply's own drape", "°"),
+}
 
 
 def blank_used_for(blank: PlyDrapeResult, ply: PlyDrapeResult) -> PatternEvaluation:

@@ -32,13 +32,14 @@ def laminate(
 
     Writes laminate.json, laminate.md (the pair matrices), laminate.vtu (the draped warp and
     fill per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply),
-    orientations.csv and patterns/drape_ANGLEdeg.vtu into the output directory. Exit status 1
-    when a ply did not converge.
+    orientations.csv, patterns/drape_ANGLEdeg.vtu, plybook.html (the ply book), plies/PLY.dxf
+    (each ply's cutter file) and, with a roll_width, nest.dxf (every ply nested on the roll)
+    into the output directory. Exit status 1 when a ply did not converge.
     """
 
     def body() -> None:
         from ..laminate_job import load_laminate_job
-        from ..laminate_outputs import laminate_files, run_laminate
+        from ..laminate_outputs import laminate_files, run_laminate_job
 
         job = load_laminate_job(job_file)
         if output is not None:
@@ -52,9 +53,11 @@ def laminate(
                     f"{drape.pattern.iterations} iterations, {drape.seconds:.2f} s"
                 )
 
-        result = run_laminate(job, force=force, workers=workers, callback=progress)
+        run = run_laminate_job(job, force=force, workers=workers, callback=progress)
+        result = run.result
         if not quiet:
             _show(result)
+            _show_cutting(run)
             for path in laminate_files(job, result.labels):
                 console.print(f"  wrote {path}")
         if not result.converged:
@@ -82,3 +85,33 @@ def _show(result) -> None:
         f"{len(result.laminate.plies)} plies, {len(result.drapes)} distinct drapes in "
         f"{result.seconds:.2f} s on {result.workers} worker(s)"
     )
+
+
+def _show_cutting(run) -> None:
+    from rich.table import Table
+
+    units = run.units
+    table = Table(
+        "ply", "orientation", f"net area [{units}²]", f"blank area [{units}²]", "mass [g]",
+        title=f"plies as cut (trim allowance {run.result.laminate.options.trim_allowance:g} "
+        f"{units})",
+    )  # fmt: skip
+    for blank in run.blanks:
+        mass = blank.mass(blank.net_area, units)
+        table.add_row(
+            blank.name,
+            f"{blank.orientation:+g}°",
+            f"{blank.net_area:.6g}",
+            f"{blank.trim_area:.6g}",
+            "–" if mass is None else f"{mass:.4g}",
+        )
+    console.print(table)
+    nest = run.nest
+    if nest is not None:
+        console.print(
+            f"nest: {len(nest.pieces)} plies on a roll {nest.roll_width:g} {units} wide, "
+            f"{nest.length:.6g} {units} long, yield {100 * nest.yield_:.1f} % "
+            f"({nest.elapsed:.1f} s)"
+        )
+    elif run.nest_error is not None:
+        console.print(f"not nested: {run.nest_error}")

@@ -1,0 +1,336 @@
+"""The ply book of a laminate (``plybook.html``): one HTML file, a summary of the laminate, then a
+section per ply.
+
+The summary: every ply's orientation, thickness, areas, mass, largest shear and producibility, the
+stacking sequence with its thicknesses, the nest on the roll and the pair matrices of the
+ply-stack check. Each ply's section: its flat blank with the net and extended boundaries and the
+rosette (the 0° arrow along the warp, the 90° arrow along the fill, at the seed), its shear and
+producibility maps, its numbers, and its darts.
+
+Producibility here is that of the blank as cut: the mechanical drape's shear angle against the
+locking angle of the ply's fabric kind (warning from :class:`~vares.analysis.drape_options.
+DrapeOptions`' ``warn_fraction`` of it); the kinematic net's fractions stand beside it.
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..analysis.drape_options import DrapeOptions
+from ..analysis.producibility import CLASSES, Producibility, producibility
+from ..materials.forming import locking_angle
+from ..structures.laminate import LaminateResult, PlyDrapeResult
+from ..structures.laminate_blanks import PlyBlank
+from ..structures.laminate_pairs import PAIR_TITLES
+from ..structures.nesting import RollNest
+from .html_parts import REPORT_DPI, figure, number, page, report_drawing, status_text, table
+
+__all__ = ["BOOK_MATRICES", "ply_book", "ply_producibility"]
+
+#: The pair matrices the book shows.
+BOOK_MATRICES = ("warp_compressed_fraction", "largest_compression", "mean_deviation")
+#: Colours of the producibility classes (ok, warn, limit, none).
+_CLASS_COLOURS = ("#4caf50", "#ffb300", "#d32f2f", "#bdbdbd")
+
+
+def ply_producibility(result: LaminateResult, name: str) -> Producibility:
+    """The producibility of ply ``name``'s blank: its mechanical shear angle per cell of the
+    ply's mesh against the locking angle of its fabric kind (module docs)."""
+    drape = result.drape(name)
+    ply = next(p for p in result.laminate.plies if p.name == name)
+    kind = ply.options.fabric_kind or result.laminate.options.fabric_kind
+    return producibility(
+        drape.pattern.fields["shear_angle"],
+        drape.mesh.cell_areas(),
+        locking_angle(kind),
+        DrapeOptions().warn_fraction,
+    )
+
+
+def _polygons(blank: PlyBlank) -> list[np.ndarray]:
+    return [blank.coordinates[c] for cells in blank.mesh.cells.values() for c in cells]
+
+
+def _outline(ax, blank: PlyBlank) -> None:
+    for rings, style in ((blank.trim, dict(color="#c62828", ls="--")), (blank.net, {})):
+        for ring in rings:
+            closed = np.vstack([ring, ring[:1]])
+            ax.plot(closed[:, 0], closed[:, 1], lw=1.0, **({"color": "black"} | style))
+    ax.set_aspect("equal")
+
+
+def _blank_figure(blank: PlyBlank, units: str):
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+
+    fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
+    ax.add_collection(
+        PolyCollection(_polygons(blank), facecolor="#e3e8ef", edgecolor="none", antialiased=False)
+    )
+    _outline(ax, blank)
+    size = float(np.ptp(blank.trim[0], axis=0).max())
+    for direction, text, colour in (
+        (blank.warp, "0° warp", "#1565c0"),
+        (blank.fill, "90° fill", "#2e7d32"),
+    ):
+        d = 0.2 * size * direction / np.linalg.norm(direction)
+        ax.annotate(
+            "",
+            xy=tuple(blank.origin + d),
+            xytext=tuple(blank.origin),
+            arrowprops=dict(arrowstyle="-|>", color=colour, lw=2.0),
+        )
+        ax.text(*(blank.origin + 1.12 * d), text, color=colour, ha="center", va="center")
+    ax.plot(*blank.origin, "o", color="black", ms=4)
+    ax.set_title(f"{blank.name}: flat blank, net (black) and trim (red, +{blank.allowance:g})")
+    ax.set_xlabel(f"along the warp [{units}]")
+    ax.set_ylabel(f"[{units}]")
+    return fig
+
+
+def _producibility_figure(blank: PlyBlank, check: Producibility):
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Patch
+
+    colours = {name: c for name, c in zip(CLASSES, _CLASS_COLOURS, strict=True)}
+    fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
+    faces = [colours[c] for c in check.classes]
+    ax.add_collection(
+        PolyCollection(_polygons(blank), facecolor=faces, edgecolor="none", antialiased=False)
+    )
+    _outline(ax, blank)
+    labels = {
+        "ok": f"ok (< {check.warn_angle:g}°)",
+        "warn": f"warn ({check.warn_angle:g}–{check.locking_angle:g}°)",
+        "limit": f"limit (≥ {check.locking_angle:g}°)",
+    }
+    handles = [
+        Patch(color=colours[n], label=f"{labels[n]}: {100 * check.fractions[n]:.1f} %")
+        for n in CLASSES[:3]
+    ]
+    ax.legend(handles=handles, loc="upper right", fontsize=8)
+    ax.set_title(f"{blank.name}: producibility (shear against the locking angle)")
+    return fig
+
+
+def _mass(blank: PlyBlank, area: float, units: str) -> str:
+    mass = blank.mass(area, units)
+    return "–" if mass is None else f"{number(mass, 4)} g"
+
+
+def _optional(value: float | None, unit: str) -> str:
+    return "–" if value is None else f"{number(value, 4)} {unit}"
+
+
+def _summary_rows(result, blanks, checks, units) -> list[tuple]:
+    rows = []
+    for blank, check in zip(blanks, checks, strict=True):
+        f = check.fractions
+        rows.append(
+            (
+                blank.name,
+                f"{blank.orientation:+g}°",
+                blank.drape,
+                _optional(blank.thickness, "mm"),
+                f"{number(blank.net_area)} {units}²",
+                f"{number(blank.trim_area)} {units}²",
+                _mass(blank, blank.net_area, units),
+                f"{number(check.max_shear, 3)}°",
+                *(f"{100 * f[n]:.1f} %" for n in CLASSES[:3]),
+            )
+        )
+    return rows
+
+
+def _stacking(blanks: Sequence[PlyBlank], result: LaminateResult) -> list[str]:
+    rows, height = [], 0.0
+    for position, (blank, ply) in enumerate(zip(blanks, result.laminate.plies, strict=True), 1):
+        top = None if blank.thickness is None or height is None else height + blank.thickness
+        drop = ply.options.drop_off
+        region = ply.options.region or "whole mould"
+        rows.append(
+            (
+                position,
+                blank.name,
+                f"{blank.orientation:+g}°",
+                _optional(blank.thickness, "mm"),
+                _optional(top, "mm"),
+                region,
+                "–" if drop is None else drop,
+            )
+        )
+        height = top
+    header = ("from the mould", "ply", "orientation", "thickness", "to", "region", "drop-off")
+    total = "–" if height is None else f"{number(height, 4)} mm"
+    return [
+        "<h2>Stacking sequence</h2>",
+        "<p>Bottom (mould side) first; thicknesses are the cured plies'.</p>",
+        table(rows, header, ident="stacking"),
+        f"<p id='total-thickness'>Total thickness: {total}.</p>",
+    ]
+
+
+def _matrix(result: LaminateResult, value: str) -> str:
+    title, unit = PAIR_TITLES[value]
+    scale = 100.0 if unit == "%" else 1.0
+    rows = [
+        (label, *("–" if not np.isfinite(v) else f"{scale * v:.2f}" for v in row))
+        for label, row in zip(result.labels, result.pair_matrix(value), strict=True)
+    ]
+    caption = f"<p><b>{html.escape(title)}</b> [{unit}]; row: the blank of, column: used for</p>"
+    return caption + table(rows, ("blank \\ ply", *result.labels), ident=f"pairs-{value}")
+
+
+def _nest_section(nest: RollNest | None, blanks, units: str) -> list[str]:
+    parts = ["<h2>Nest on the roll</h2>"]
+    if nest is None:
+        return [*parts, "<p id='nest'>Not nested: the laminate names no roll_width.</p>"]
+    from ..io.dxf import NestedDrawing
+    from ..io.plot import plot_nest
+
+    rows = [
+        ("roll width", f"{number(nest.roll_width)} {units}"),
+        ("length used", f"{number(nest.length)} {units}"),
+        ("net area of the plies", f"{number(nest.net_area)} {units}²"),
+        ("yield (net area / roll used)", f"{100 * nest.yield_:.1f} %"),
+    ]
+    drawings = []
+    for piece in nest.pieces:
+        blank = blanks[piece.index]
+        angle = np.radians(piece.rotation)
+        warp = np.array([np.cos(angle), np.sin(angle)])
+        drawings.append(
+            NestedDrawing(
+                blank.name, piece.place(blank.net[0]), piece.place(blank.trim[0]), warp, ()
+            )
+        )
+    fig = plot_nest(nest.roll_width, nest.length, drawings, units=units)
+    return [
+        *parts,
+        table(rows, ident="nest"),
+        figure(fig, "the plies on the roll (warp along the roll)", "figure-nest"),
+    ]
+
+
+def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> list[str]:
+    drape: PlyDrapeResult = result.drape(blank.name)
+    ply = next(p for p in result.laminate.plies if p.name == blank.name)
+    pattern = drape.pattern
+    rows = [
+        ("orientation", f"{blank.orientation:+g}° from the reference"),
+        ("drape", f"{drape.label} (plies {', '.join(drape.plies)})"),
+        ("material", type(ply.material).__name__),
+        ("state", status_text(pattern.converged, pattern.reason)),
+        ("seed", " ".join(number(v, 6) for v in drape.seed)),
+        ("warp at the seed", " ".join(number(v, 4) for v in drape.warp_direction)),
+        ("thickness", _optional(blank.thickness, "mm")),
+        ("areal weight", _optional(blank.areal_weight, "g/m²")),
+        ("area on the mould", f"{number(blank.surface_area)} {units}²"),
+        ("net area (flat)", f"{number(blank.net_area)} {units}²"),
+        (f"blank area (trim +{blank.allowance:g} {units})", f"{number(blank.trim_area)} {units}²"),
+        ("mass of the net", _mass(blank, blank.net_area, units)),
+        ("mass of the blank as cut", _mass(blank, blank.trim_area, units)),
+        ("largest shear", f"{number(check.max_shear, 4)}°"),
+        ("locking angle", f"{number(check.locking_angle, 4)}°"),
+    ]
+    rows += [(f"area {n}", f"{100 * check.fractions[n]:.2f} %") for n in CLASSES[:3]]
+    if drape.kinematic is not None:
+        net = drape.kinematic.producibility
+        rows.append(
+            (
+                "kinematic net: ok / warn / limit",
+                " / ".join(f"{100 * net.fractions[n]:.1f} %" for n in CLASSES[:3]),
+            )
+        )
+    state = rows.pop(3)  # its cell holds markup: not escaped
+    ident = html.escape(blank.name)
+    limit = 100 * check.fractions["limit"]
+    darts = (
+        f"<p id='darts-{ident}'>No darts: vares does not cut darts yet. "
+        f"{limit:.1f} % of the ply's area is at or beyond the locking angle"
+        + (" (a dart or another seed or orientation is needed there)." if limit > 0 else ".")
+        + "</p>"
+    )
+    return [
+        f"<section class='ply' id='ply-{ident}'>",
+        f"<h2>Ply {ident}: {blank.orientation:+g}°</h2>",
+        f"<p>{html.escape(state[0])}: {state[1]}</p>",
+        table(rows, ident=f"ply-table-{ident}"),
+        *(part.replace("{ply}", ident) for part in figures[drape.label]),
+        "<h3>Darts</h3>",
+        darts,
+        "</section>",
+    ]
+
+
+def _drape_figures(
+    blank: PlyBlank, shear: np.ndarray, check: Producibility, units: str
+) -> list[str]:
+    """The three pictures of a drape's blank, their ids holding ``{ply}``."""
+    from ..io.plot import plot_pattern_fields
+
+    parts = [figure(_blank_figure(blank, units), "flat blank and rosette", "figure-{ply}-blank")]
+    titles = {"shear_angle": "shear angle [°]"}
+    for _, drawing in plot_pattern_fields(
+        blank.mesh, blank.coordinates, {"shear_angle": shear}, titles=titles, dpi=REPORT_DPI
+    ):
+        parts.append(figure(drawing, "shear angle of the blank", "figure-{ply}-shear", close=False))
+    parts.append(
+        figure(_producibility_figure(blank, check), "producibility", "figure-{ply}-producibility")
+    )
+    return parts
+
+
+def _summary_parts(result, blanks, nest, checks, units: str) -> list[str]:
+    header = ("ply", "orientation", "drape", "thickness", "net area", "blank area", "mass",
+              "largest shear", "ok", "warn", "limit")  # fmt: skip
+    masses = [b.mass(b.net_area, units) for b in blanks]
+    total = "–" if None in masses else f"{number(sum(masses), 5)} g"
+    return [
+        "<h2>Laminate</h2>",
+        f"<p>{len(blanks)} plies, {len(result.drapes)} distinct drapes, reference direction "
+        f"{tuple(result.laminate.options.reference)}; areas in {units}², masses of the flat "
+        "nets.</p>",
+        table(_summary_rows(result, blanks, checks, units), header, ident="laminate-summary"),
+        f"<p id='total-mass'>Total mass of the nets: {total}.</p>",
+        *_stacking(blanks, result),
+        *_nest_section(nest, blanks, units),
+        "<h2>Ply-stack check</h2>",
+        *(_matrix(result, v) for v in BOOK_MATRICES),
+    ]
+
+
+def ply_book(
+    result: LaminateResult,
+    blanks: Sequence[PlyBlank],
+    nest: RollNest | None,
+    *,
+    units: str,
+    title: str = "laminate",
+) -> str:
+    """The ply book as one HTML page (module docs): ``blanks`` of :func:`~vares.structures.
+    laminate_blanks.ply_blanks` (bottom first), ``nest`` of :func:`~vares.structures.
+    laminate_blanks.nest_plies` or ``None``, in mesh ``units``."""
+    checks = [ply_producibility(result, b.name) for b in blanks]
+    warnings = [
+        f"drape {d.label} did not converge: {d.pattern.reason}"
+        for d in result.drapes
+        if not d.converged
+    ]
+    if any(b.areal_weight is None for b in blanks):
+        warnings.append("no areal weight for some plies: their masses are not shown")
+    status = status_text(result.converged, None if result.converged else "see the warnings")
+    parts = page(title, f"Ply book: {title}", status, warnings)
+    with report_drawing():
+        parts += _summary_parts(result, blanks, nest, checks, units)
+        figures: dict[str, list[str]] = {}
+        for blank, check in zip(blanks, checks, strict=True):
+            if blank.drape not in figures:
+                shear = result.drape(blank.name).pattern.fields["shear_angle"]
+                figures[blank.drape] = _drape_figures(blank, shear, check, units)
+            parts += _ply_section(result, blank, check, units, figures)
+    return "\n".join([*parts, "</body></html>"])

@@ -1,0 +1,158 @@
+"""The blanks of a laminate's plies as cut: net and extended (trim) boundaries, the rosette at the
+ply's seed, areas and masses, and every ply nested on the roll (DESIGN.md §8).
+
+A ply's **net boundary** is its pattern's boundary (the part's edge, flat); its **extended
+boundary** is the net grown by ``trim_allowance`` (mesh units, mitred corners): the blank as cut,
+with the excess trimmed after draping. The **rosette** sits at the pattern point of the mould node
+nearest the ply's seed, with the warp (0°) and the fill (90°) of the ply's pattern. Every pattern
+comes with its warp along +x, which is the roll's direction: the plies are nested as they are
+(or turned by 180°, which keeps the warp along the roll) by
+:func:`vares.structures.nesting.nest_pieces`.
+A ply's mass is that of its flat blank: the areal weight (g/m², of the undeformed fabric) times
+the pattern's area.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.mesh import SurfaceMesh
+from ..units import METRES
+from .laminate import LaminateResult
+from .nesting import RollNest, nest_pieces, usable_width
+
+__all__ = ["MITRE_LIMIT", "PlyBlank", "extended_boundary", "nest_plies", "ply_blanks", "ring_area"]
+
+#: Longest mitre of the extended boundary's corners, in allowances (shapely's ``mitre_limit``).
+MITRE_LIMIT = 4.0
+
+
+def ring_area(ring: np.ndarray) -> float:
+    """The signed area of a closed ring ``(k, 2)`` (positive counter-clockwise)."""
+    x, y = ring[:, 0], ring[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+@dataclass(frozen=True)
+class PlyBlank:
+    """One ply's blank in its pattern frame (mesh units, warp along +x).
+
+    ``net``: the pattern's boundary rings ``(k, 2)``, the outline first, then holes; ``trim``:
+    the extended boundary's rings, likewise; ``origin`` ``(2,)``: the rosette's point (the
+    pattern point of the mould node nearest the seed); ``warp``, ``fill`` ``(2,)``: the unit yarn
+    directions of the pattern; ``net_area``, ``trim_area``: flat areas; ``surface_area``: the 3D
+    area of the ply on the mould; ``areal_weight`` (g/m²) and ``thickness`` (mm) when known.
+    """
+
+    name: str
+    drape: str
+    orientation: float
+    mesh: SurfaceMesh
+    coordinates: np.ndarray
+    net: list[np.ndarray]
+    trim: list[np.ndarray]
+    origin: np.ndarray
+    warp: np.ndarray
+    fill: np.ndarray
+    net_area: float
+    trim_area: float
+    surface_area: float
+    allowance: float
+    areal_weight: float | None
+    thickness: float | None
+
+    def mass(self, area: float, units: str) -> float | None:
+        """Grams of fabric in ``area`` (mesh units², e.g. :attr:`net_area`) of mesh ``units``;
+        ``None`` without an areal weight."""
+        if self.areal_weight is None:
+            return None
+        return self.areal_weight * area * METRES[units] ** 2
+
+    @property
+    def width(self) -> float:
+        """The extended blank's width across the warp (along y)."""
+        return float(np.ptp(self.trim[0][:, 1]))
+
+
+def _rings(polygon) -> list[np.ndarray]:
+    from shapely.geometry.polygon import orient
+
+    polygon = orient(polygon, 1.0)  # the outline counter-clockwise, holes clockwise
+    rings = [np.asarray(polygon.exterior.coords)[:-1]]
+    return rings + [np.asarray(r.coords)[:-1] for r in polygon.interiors]
+
+
+def extended_boundary(net: Sequence[np.ndarray], allowance: float) -> list[np.ndarray]:
+    """The net rings (outline first, then holes) grown by ``allowance`` ≥ 0 with mitred corners
+    (at most :data:`MITRE_LIMIT` allowances out): the outline first, then what is left of the
+    holes."""
+    from shapely.geometry import Polygon
+
+    polygon = Polygon(net[0], list(net[1:]))
+    if allowance > 0:
+        polygon = polygon.buffer(allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
+    if polygon.geom_type != "Polygon":  # holes never split a grown polygon; keep the largest
+        polygon = max(polygon.geoms, key=lambda g: g.area)
+    return _rings(polygon)
+
+
+def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
+    """Every ply's blank, bottom first (module docs), with the laminate's ``trim_allowance``."""
+    options = result.laminate.options
+    allowance = float(options.trim_allowance)
+    blanks = []
+    for ply in result.laminate.plies:
+        drape = result.drape(ply.name)
+        coordinates = drape.pattern.material_coordinates
+        loops = [coordinates[loop] for loop in drape.mesh.boundary_loops()]
+        loops.sort(key=lambda r: -abs(ring_area(r)))
+        net = [r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)]
+        trim = extended_boundary(net, allowance)
+        node = int(np.argmin(np.linalg.norm(drape.mesh.points - drape.seed, axis=1)))
+        fibres = drape.pattern.fibres
+        o = ply.options
+        blanks.append(
+            PlyBlank(
+                name=ply.name,
+                drape=drape.label,
+                orientation=float(o.orientation),
+                mesh=drape.mesh,
+                coordinates=coordinates,
+                net=net,
+                trim=trim,
+                origin=coordinates[node].copy(),
+                warp=np.asarray(fibres.warp, dtype=float),
+                fill=np.asarray(fibres.fill, dtype=float),
+                net_area=ring_area(net[0]) + sum(ring_area(r) for r in net[1:]),
+                trim_area=ring_area(trim[0]) + sum(ring_area(r) for r in trim[1:]),
+                surface_area=float(drape.mesh.cell_areas().sum()),
+                allowance=allowance,
+                areal_weight=o.areal_weight or options.areal_weight,
+                thickness=o.thickness or options.ply_thickness,
+            )
+        )
+    return blanks
+
+
+def nest_plies(
+    blanks: Sequence[PlyBlank], roll_width: float, *, time_limit: float = 10.0
+) -> RollNest:
+    """Every blank's extended outline on a roll of ``roll_width`` (mesh units), the warp along
+    the roll; the yield is the net area over the roll used. A blank wider than the roll takes
+    is refused with its name and width."""
+    widest = usable_width(roll_width)
+    for blank in blanks:
+        if blank.width > widest:
+            raise ValueError(
+                f"ply {blank.name} is {blank.width:.6g} wide across its warp (with the trim "
+                f"allowance); a roll_width of {roll_width:g} takes at most {widest:.6g}"
+            )
+    return nest_pieces(
+        [b.trim[0] for b in blanks],
+        roll_width,
+        net_areas=[b.net_area for b in blanks],
+        time_limit=time_limit,
+    )
