@@ -15,8 +15,8 @@ from matplotlib.colors import Normalize, TwoSlopeNorm
 from matplotlib.image import AxesImage
 
 from ..mechanics.fields import FIELD_DESCRIPTIONS
+from .drawing import MARGINS
 from .raster import CellImage
-from .sketch import MARGINS
 
 __all__ = [
     "FIELD_LABELS",

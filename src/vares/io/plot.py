@@ -18,6 +18,7 @@ from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres
+from .drawing import DPI, FACE, MARGINS, MESH, MESH_LINES_UP_TO, SIDE, fibre_arrow_length
 from .figures import (
     FIELD_LABELS,
     DrawnField,
@@ -31,7 +32,6 @@ from .figures import (
     rgba_bytes,
 )
 from .raster import CellImage, View, rasterise
-from .sketch import DPI, FACE, MARGINS, MESH, MESH_LINES_UP_TO, SIDE, fibre_arrow_length
 from .surface_plot import plot_cut_lines, plot_surface, plot_surface_fields
 
 __all__ = [

@@ -14,6 +14,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import to_rgba
 
 from ..geometry.mesh import SurfaceMesh
+from .drawing import DPI, FACE, MESH_LINES_UP_TO
 from .figures import (
     DrawnField,
     axes_pixels,
@@ -25,7 +26,6 @@ from .figures import (
     rgba_bytes,
 )
 from .raster import View, rasterise
-from .sketch import DPI, FACE, MESH_LINES_UP_TO
 
 __all__ = ["plot_cut_lines", "plot_surface", "plot_surface_fields"]
 
