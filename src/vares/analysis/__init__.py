@@ -1,7 +1,7 @@
 """What a pattern does: per-cell results of any pattern, the compensation report, statistics,
 the erection analysis (the structure built from its patterns) and patterns optimised for it,
 and the producibility of a
-draped ply."""
+draped ply and its darts."""
 
 from typing import TYPE_CHECKING
 
@@ -11,6 +11,8 @@ if TYPE_CHECKING:
     from ..mechanics.fields import FIELD_DESCRIPTIONS, KEY_FIELDS, cell_fields
     from .checks import pattern_warnings
     from .compensation import CompensationReport, YarnReport, compensation_report
+    from .dart_options import DartOptions
+    from .darts import DartedPattern, solve_with_darts
     from .drape import PlyDrape, drape_ply
     from .drape_options import DrapeOptions
     from .erection import ErectionResult, erect

@@ -6,7 +6,9 @@ Each pattern becomes closed polylines in real units on named layers:
 ``CUT``    the boundary grown by the seam allowance (shapely buffer with mitred corners);
 ``WARP``   an arrow along the warp direction;
 ``MARKS``  match marks: short ticks across the seam line at a fixed spacing along it;
-``LABEL``  the panel name, areas and compensation.
+``LABEL``  the panel name, areas and compensation;
+``DART``   the darts of a ply: each dart's two lips from the mouth to the tip and back, an open
+           polyline (the notch the seam line runs round).
 
 Several patterns are laid out side by side, without overlap, along x.
 """
@@ -35,16 +37,17 @@ __all__ = [
 
 #: DXF ``$INSUNITS`` code of each length unit.
 INSUNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1, "ft": 2}
-LAYERS = {"SEAM": 7, "CUT": 1, "WARP": 5, "MARKS": 3, "LABEL": 2}
+LAYERS = {"SEAM": 7, "CUT": 1, "WARP": 5, "MARKS": 3, "LABEL": 2, "DART": 6}
 
 
 @dataclass
 class CutPiece:
     """One pattern to draw: coordinates ``(n, 2)`` in model units, warp direction ``(2,)``,
     label lines, optionally match mark positions (model units, ``(k, 2)``, on the seam line)
-    that replace the regularly spaced ones, and optionally its cut line (a ring ``(k, 2)`` in
+    that replace the regularly spaced ones, optionally its cut line (a ring ``(k, 2)`` in
     model units, e.g. with an allowance per edge) that replaces the seam line grown by the
-    drawing's allowance."""
+    drawing's allowance, and its darts (open polylines ``(k, 2)`` in model units, drawn on
+    layer ``DART``)."""
 
     name: str
     mesh: SurfaceMesh
@@ -53,6 +56,7 @@ class CutPiece:
     label: Sequence[str] = ()
     marks: np.ndarray | None = field(default=None, repr=False)
     cut: np.ndarray | None = field(default=None, repr=False)
+    darts: Sequence[np.ndarray] = field(default=(), repr=False)
 
 
 def _signed_area(ring: np.ndarray) -> float:
@@ -146,6 +150,9 @@ def write_dxf(
             space.add_lwpolyline(ring + shift, close=True, dxfattribs={"layer": "SEAM"})
         for ring in cuts:
             space.add_lwpolyline(ring + shift, close=True, dxfattribs={"layer": "CUT"})
+        for dart in piece.darts:
+            line = np.asarray(dart, dtype=float) * factor + shift
+            space.add_lwpolyline(line, dxfattribs={"layer": "DART"})
         centre = coordinates.mean(axis=0) + shift
         if piece.warp is not None:
             warp = np.asarray(piece.warp, dtype=float)

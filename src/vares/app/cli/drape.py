@@ -1,13 +1,19 @@
-"""``vares drape``: the kinematic drape of a woven ply on a mould, and its producibility."""
+"""``vares drape``: the kinematic drape of a woven ply on a mould, its producibility, and its
+darts (``--darts auto`` or ``--dart-lines FILE``: the ply's pattern solved with its fabric, then
+again with the darts open)."""
 
 from pathlib import Path
 from typing import Annotated, Any
 
+import numpy as np
 import typer
 
+from ...analysis.dart_options import DartOptions
 from ...analysis.drape_options import DrapeOptions
+from ...units import METRES
+from ..sections import MaterialOptions
 from .common import console, guarded
-from .flags import build, flags, option_parameter, with_flags
+from .flags import InputError, build, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
 __all__ = ["drape"]
@@ -22,10 +28,20 @@ OUTPUT_FLAGS = [
         help="Output directory.",
         panel="Output",
     ),
+    option_parameter(
+        "units",
+        "mm",
+        str,
+        "--units",
+        help="Units of the mould's coordinates, for pattern.dxf (" + ", ".join(METRES) + ").",
+        panel="Output",
+    ),
 ]
 
 
-@with_flags(flags(DrapeOptions), OUTPUT_FLAGS, RUN_FLAGS[1:])
+@with_flags(
+    flags(DrapeOptions), flags(DartOptions), flags(MaterialOptions), OUTPUT_FLAGS, RUN_FLAGS[1:]
+)
 def drape(
     surface: Annotated[Path, typer.Argument(help="The mould's surface mesh.")],
     **values: Any,
@@ -34,7 +50,11 @@ def drape(
 
     Writes drape.json (the producibility and the net) and drape.vtu (the mould with the shear
     angle, the producibility class, the yarn directions and the flat pattern per node) into the
-    output directory.
+    output directory. With --darts auto or --dart-lines the ply's pattern is solved with its
+    fabric (--fabric, or --material and its parameters), darts are opened where its shear
+    reaches the locking angle (or along the given lines) and it is solved again: drape.json
+    gets the darts, and darts.vtu (the mould cut open), pattern.dxf (the pattern with layer
+    DART) and darts.png (the shear before and after, the dart lines) are written.
     """
 
     def body() -> None:
@@ -45,9 +65,21 @@ def drape(
         from ..staging import OutputFolder
 
         options = build(DrapeOptions, values)
+        darting = build(DartOptions, values)
+        material = _material(values, darting)
+        if values["units"] not in METRES:
+            raise InputError(f"--units must be one of {', '.join(METRES)}; got {values['units']!r}")
+        polylines = None
+        if darting.dart_lines is not None:
+            from ...io.curves import read_curves
+
+            polylines = read_curves(darting.dart_lines)
         mesh = read_mesh(surface)
         output = values["output"]
         paths = [output / "drape.json", output / "drape.vtu"]
+        dart_paths = [output / "darts.vtu", output / "pattern.dxf", output / "darts.png"]
+        if darting.wanted:
+            paths += dart_paths
         folder = OutputFolder(
             output, paths, force=values["force"], inputs=[surface], command="drape"
         )
@@ -64,19 +96,103 @@ def drape(
         }
         point_data = {"flat_u": result.material_coordinates[:, 0]}
         point_data["flat_v"] = result.material_coordinates[:, 1]
+        darted = None
+        if darting.wanted:
+            from ...analysis.darts import solve_with_darts
+
+            locking, _ = options.locking
+            darted = solve_with_darts(
+                mesh,
+                material,
+                values["thickness"],
+                locking_angle=locking,
+                polylines=polylines,
+                options=darting,
+                warp_direction=tuple(float(v) for v in ply.warp),
+            )
+            data["darts"] = darted.summary()
         folder.start()
         try:
             write_surface(folder.staged(paths[1]), mesh, None, fields, point_data)
             write_json(folder.staged(paths[0]), data)
+            if darted is not None:
+                _write_darts(folder, dart_paths, darted, values["units"], surface.stem)
             folder.commit()
         finally:
             folder.discard()
         if not values["quiet"]:
             _show(check, options.warn_fraction, result.net.valid.sum(), ply.spacing)
+            if darted is not None:
+                _show_darts(darted)
             for path in paths:
                 console.print(f"  wrote {path}")
+        if darted is not None and not (darted.after or darted.before).converged:
+            raise typer.Exit(1)
 
     guarded(body)
+
+
+def _material(values: dict[str, Any], darting: DartOptions):
+    """The ply's fabric for the solves with darts (None without darts); material flags without
+    darts are refused."""
+    options = build(MaterialOptions, values)
+    given = [n for n, d in MaterialOptions.defaults().items() if getattr(options, n) != d]
+    if not darting.wanted:
+        if given:
+            raise InputError(f"--{given[0].replace('_', '-')} is for darts: add --darts auto")
+        return None
+    if options.law is None and options.fabric is None and options.presets is None:
+        raise InputError("darts need the ply's fabric: give --fabric, or --material and its moduli")
+    material = options.build(Path.cwd())
+    if not material.needs_fibres:
+        raise InputError("darts need a fabric with yarns (an orthotropic or ncf law, or --fabric)")
+    return material
+
+
+def _write_darts(folder, paths: list[Path], darted, units: str, name: str) -> None:
+    import matplotlib.pyplot as plt
+
+    from ...io.dart_plots import plot_darts
+    from ...io.dxf import CutPiece, write_dxf
+    from ...io.meshes import write_surface
+
+    final = darted.after or darted.before
+    fields = {"shear_angle": final.fields["shear_angle"]}
+    flat = final.material_coordinates
+    point_data = {"flat_u": flat[:, 0], "flat_v": flat[:, 1]}
+    write_surface(folder.staged(paths[0]), final.mesh, None, fields, point_data)
+    summary = darted.summary()
+    label = [
+        f"{summary['darts']} darts, largest shear {np.nanmax(np.abs(fields['shear_angle'])):.1f}°"
+    ]
+    piece = CutPiece(
+        name, final.mesh, flat, final.fibres.warp, label, darts=darted.dart_pattern_lines()
+    )
+    write_dxf(folder.staged(paths[1]), [piece], units=units, model_units=units)
+    figure = plot_darts(darted)
+    figure.savefig(folder.staged(paths[2]))
+    plt.close(figure)
+
+
+def _show_darts(darted) -> None:
+    from rich.table import Table
+
+    summary = darted.summary()
+    table = Table(
+        "dart", "length", "mouth opening", title=f"darts (locking {darted.locking_angle:g}°)"
+    )
+    for k, (length, opening) in enumerate(
+        zip(summary["dart_lengths"], summary["mouth_openings"], strict=True), start=1
+    ):
+        table.add_row(str(k), f"{length:.4g}", f"{opening:.4g}")
+    console.print(table)
+    after = summary["max_shear_after"]
+    tail = "no dart needed" if after is None else f"{after:.2f}° with the darts open"
+    state = "below" if darted.relieved else "NOT below"
+    console.print(
+        f"largest shear of the pattern {summary['max_shear_before']:.2f}° without darts, {tail}: "
+        f"{state} the locking angle ({len(darted.rounds)} solves with darts)"
+    )
 
 
 def _show(check, warn_fraction: float, nodes: int, spacing: float) -> None:

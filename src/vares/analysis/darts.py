@@ -1,0 +1,378 @@
+"""Darts: cuts from a ply's boundary into the region whose shear exceeds the locking angle, and
+the pattern solved again with the darts open (DESIGN.md §8).
+
+**Where.** The cells at or beyond the locking angle form regions (neighbours across edges). A
+region that reaches the boundary gets one dart from the boundary side nearest the region's
+shear-weighted centre there (weights: the shear beyond the locking angle); a region inside the
+surface, from the boundary side nearest its most sheared cell.
+
+**Which way.** Sheared yarns at an angle ``θ < 90°`` lengthen the bisector of their acute angle
+(``2 cos(θ/2)``) and shorten the other diagonal (``2 sin(θ/2)``): the fabric is squeezed across
+the bisector. A cut along the bisector opens against that squeeze, and relieves the most shear.
+The dart follows the bisector of the erected yarns (``F Φ₁``, ``F Φ₂`` of the pattern) from cell
+to cell (:func:`vares.geometry.slits.walk_line`) until the shear falls below the dart's
+**tip angle**, or to ``max_length``. On a sphere, with the warp along a symmetry plane, the
+bisector on the 45° meridians is the meridian itself.
+
+**How far.** :func:`solve_with_darts` solves the pattern, places the darts with the tip angle
+``dart_tip × locking angle``, opens them (:func:`vares.geometry.slits.open_slits`: both lips
+free boundary, joined at the tip) and solves again, started from the first pattern; while the
+largest shear is still at or beyond the locking angle it lengthens the darts (the tip angle
+lowered by ``dart_step × locking angle``) for at most ``dart_rounds`` rounds
+(:class:`~vares.analysis.dart_options.DartOptions`). Dart lines a user gives
+(polylines near the mould, :func:`darts_from_polylines`) are opened as they are, once.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from ..geometry.drawn_lines import closest_points
+from ..geometry.mesh import SurfaceMesh
+from ..geometry.slits import SlitMesh, open_slits, walk_line
+from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
+from ..geometry.surface_points import FaceLocator, face_neighbours
+from ..materials import Hyperelastic
+from ..options import split_settings, takes_options
+from ..solver.api import solve
+from ..solver.result import PatternResult
+from .dart_options import DartOptions
+
+#: Cells at or beyond the locking angle belong to one region when cells whose smoothed shear is
+#: at least this fraction of it join them.
+JOIN_FRACTION = 0.9
+
+__all__ = [
+    "DartOptions",
+    "DartRound",
+    "DartedPattern",
+    "darts_from_polylines",
+    "erected_yarns",
+    "place_darts",
+    "smoothed",
+    "solve_with_darts",
+]
+
+
+def erected_yarns(
+    mesh: SurfaceMesh, coordinates: np.ndarray, warp: np.ndarray, fill: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The erected warp and fill ``(m, 3)`` (unit) of every triangle of ``mesh`` for the pattern
+    ``coordinates`` ``(n, 2)`` whose yarns run along ``warp`` and ``fill`` ``(2,)``: ``F Φ`` with
+    the triangle's constant deformation gradient ``F = [x₁ − x₀, x₂ − x₀] [X₁ − X₀, X₂ − X₀]⁻¹``."""
+    triangles = mesh.cells["triangle"]
+    x, X = mesh.points[triangles], np.asarray(coordinates, dtype=float)[triangles]
+    spatial = np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]], axis=-1)  # (m, 3, 2)
+    material = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], axis=-1)  # (m, 2, 2)
+    F = spatial @ np.linalg.inv(material)
+    out = []
+    for phi in (np.asarray(warp, dtype=float), np.asarray(fill, dtype=float)):
+        v = F @ phi
+        out.append(v / np.linalg.norm(v, axis=1)[:, None])
+    return out[0], out[1]
+
+
+def place_darts(
+    mesh: SurfaceMesh,
+    shear_angle: np.ndarray,
+    warp: np.ndarray,
+    fill: np.ndarray,
+    locking_angle: float,
+    tip_angle: float,
+    max_length: float | None = None,
+) -> list[SurfaceLine]:
+    """Dart lines on the triangle mesh ``mesh`` for the per-cell ``shear_angle`` ``(m,)``
+    (degrees, NaN where unknown) and erected yarns ``warp``, ``fill`` ``(m, 3)`` (module docs):
+    one per region at or beyond ``locking_angle``, from the boundary along the bisector of the
+    yarns' acute angle until the :func:`smoothed` shear is below ``tip_angle`` (or
+    ``max_length``, default half the mesh's bounding-box diagonal). Regions are taken by their
+    largest shear, largest first; cells within :data:`JOIN_FRACTION` of the locking angle
+    (smoothed) join them, and a dart that would come within two mean edge lengths of an earlier
+    one is left out (that one relieves its region)."""
+    triangles = mesh.cells["triangle"]
+    points = mesh.points
+    magnitude = np.abs(np.nan_to_num(np.asarray(shear_angle, dtype=float), nan=0.0))
+    over = magnitude >= locking_angle
+    if not over.any():
+        return []
+    smooth = smoothed(mesh, magnitude)
+    neighbours = face_neighbours(triangles)
+    acute = np.einsum("ij,ij->i", warp, fill) >= 0
+    bisector = warp + np.where(acute[:, None], fill, -fill)
+    bisector /= np.linalg.norm(bisector, axis=1)[:, None]
+    edge = float(np.linalg.norm(np.diff(points[mesh.edges()], axis=1), axis=2).mean())
+    if max_length is None:
+        max_length = 0.5 * float(np.linalg.norm(np.ptp(points, axis=0)))
+    regions = _regions(over | (smooth >= JOIN_FRACTION * locking_angle), neighbours)
+    sides = np.argwhere(neighbours < 0)  # (face, corner opposite the boundary side)
+    mids = 0.5 * (
+        points[triangles[sides[:, 0], (sides[:, 1] + 1) % 3]]
+        + points[triangles[sides[:, 0], (sides[:, 1] + 2) % 3]]
+    )
+    order = sorted(set(regions[over].tolist()), key=lambda r: -magnitude[regions == r].max())
+    lines: list[SurfaceLine] = []
+    for region in order:
+        cells = np.flatnonzero(regions == region)
+        at_boundary = np.isin(sides[:, 0], cells)
+        if at_boundary.any():
+            weights = np.maximum(magnitude[sides[at_boundary, 0]] - locking_angle, 0.0) + 1e-9
+            centre = weights @ mids[at_boundary] / weights.sum()
+        else:
+            centre = points[triangles[cells[np.argmax(magnitude[cells])]]].mean(axis=0)
+        side = int(np.argmin(np.linalg.norm(mids - centre, axis=1)))
+        face, corner = (int(v) for v in sides[side])
+        start = np.full(3, 0.5)
+        start[corner] = 0.0
+        inward = points[triangles[face, corner]] - mids[side]
+
+        def direction(cell: int, _: np.ndarray, last: np.ndarray | None, inward=inward):
+            if smooth[cell] < tip_angle:
+                return None
+            d = bisector[cell]
+            return d if d @ (inward if last is None else last) >= 0 else -d
+
+        line = walk_line(mesh, face, start, direction, max_length)
+        near = [_distance(line.points, other.points) < 2.0 * edge for other in lines]
+        if len(line.points) >= 3 and not any(near):
+            lines.append(line)
+    return lines
+
+
+def smoothed(mesh: SurfaceMesh, values: np.ndarray) -> np.ndarray:
+    """A per-cell field ``(m,)`` averaged to the nodes (area-weighted) and back to the cells
+    (mean of their nodes): the shear of linear triangles with stiff yarns scatters from cell to
+    cell, and a dart's regions and tip follow the trend, not one cell."""
+    triangles = mesh.cells["triangle"]
+    areas = mesh.cell_areas()
+    total = np.bincount(triangles.ravel(), np.repeat(areas * values, 3), mesh.num_points)
+    weight = np.bincount(triangles.ravel(), np.repeat(areas, 3), mesh.num_points)
+    return (total / np.maximum(weight, 1e-300))[triangles].mean(axis=1)
+
+
+def _distance(a: np.ndarray, b: np.ndarray) -> float:
+    """The least distance between the points of two polylines ``(k, 3)``."""
+    return float(np.min(np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)))
+
+
+def _regions(over: np.ndarray, neighbours: np.ndarray) -> np.ndarray:
+    """Connected regions of the cells ``over`` (neighbours across edges); −1 elsewhere."""
+    faces = np.repeat(np.arange(len(neighbours)), 3)
+    other = neighbours.ravel()
+    keep = (other >= 0) & over[faces] & over[np.maximum(other, 0)]
+    graph = coo_matrix(
+        (np.ones(keep.sum()), (faces[keep], other[keep])), shape=(len(over), len(over))
+    )
+    _, labels = connected_components(graph, directed=False)
+    return np.where(over, labels, -1)
+
+
+def darts_from_polylines(mesh: SurfaceMesh, polylines: Sequence[np.ndarray]) -> list[SurfaceLine]:
+    """Dart lines through the user's ``polylines`` ``(k, 3)`` (points on or near the mould): each
+    point is moved to the closest point of the surface, and the line walks from point to point
+    straight in every cell it crosses. The end nearer the boundary is the mouth (moved onto the
+    boundary); the line ends inside the surface, in the cell of the other end."""
+    triangles = mesh.cells["triangle"]
+    points = mesh.points
+    neighbours = face_neighbours(triangles)
+    sides = np.argwhere(neighbours < 0)
+    a = points[triangles[sides[:, 0], (sides[:, 1] + 1) % 3]]
+    b = points[triangles[sides[:, 0], (sides[:, 1] + 2) % 3]]
+    size = float(np.linalg.norm(np.ptp(points, axis=0)))
+    lines = []
+    for index, polyline in enumerate(polylines, start=1):
+        polyline = np.asarray(polyline, dtype=float).reshape(-1, 3)
+        if len(polyline) < 2:
+            raise CuttingError(f"dart line {index} needs two points or more")
+        faces, bary, distance = closest_points(mesh, polyline)
+        if distance.max() > 0.05 * size:
+            raise CuttingError(
+                f"dart line {index} lies up to {distance.max():.4g} from the mould: draw it on it"
+            )
+        on_surface = np.einsum("kc,kcd->kd", bary, points[triangles[faces]])
+        gaps = [_to_segments(p, a, b)[0] for p in (on_surface[0], on_surface[-1])]
+        if gaps[1] < gaps[0]:
+            on_surface, faces = on_surface[::-1], faces[::-1]
+        _, side, t = _to_segments(on_surface[0], a, b)
+        face, corner = (int(v) for v in sides[side])
+        start = np.zeros(3)
+        start[(corner + 1) % 3], start[(corner + 2) % 3] = 1.0 - t, t
+        targets = list(zip(faces[1:].tolist(), on_surface[1:], strict=True))
+
+        def direction(cell: int, here: np.ndarray, _: np.ndarray | None, targets=targets):
+            while targets and (targets[0][0] == cell or np.allclose(targets[0][1], here)):
+                targets.pop(0)
+            return None if not targets else targets[0][1] - here
+
+        length = float(np.linalg.norm(np.diff(on_surface, axis=0), axis=1).sum())
+        line = walk_line(mesh, face, start, direction, 1.5 * length + size * 1e-9)
+        if len(line.points) < 2:
+            raise CuttingError(f"dart line {index} is shorter than a cell of the mould")
+        lines.append(line)
+    return lines
+
+
+def _to_segments(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[float, int, float]:
+    """The distance from ``point`` to the nearest of the segments ``a``–``b`` ``(s, 3)``, its
+    index and the fraction along it."""
+    d = b - a
+    t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
+    distance = np.linalg.norm(a + t[:, None] * d - point, axis=1)
+    k = int(np.argmin(distance))
+    return float(distance[k]), k, float(t[k])
+
+
+@dataclass(frozen=True)
+class DartRound:
+    """One solve with darts: the tip angle (degrees; None for given lines), the darts' lengths
+    (mesh units), the largest shear after (degrees), Newton iterations, seconds, converged."""
+
+    tip_angle: float | None
+    lengths: list[float]
+    max_shear: float
+    iterations: int
+    seconds: float
+    converged: bool
+
+
+@dataclass(frozen=True)
+class DartedPattern:
+    """A pattern before and after its darts were opened.
+
+    ``before``: the pattern of the mesh without darts; ``after``: of ``slits.mesh`` with the
+    last round's darts open (None when no dart was needed or placed); ``slits``: the opened
+    mesh, its lips and the dart lines ``(k, 3)`` on the mould; ``rounds``: every solve with
+    darts; ``locking_angle`` in degrees.
+    """
+
+    before: PatternResult
+    after: PatternResult | None
+    slits: SlitMesh | None
+    locking_angle: float
+    rounds: list[DartRound] = field(default_factory=list)
+
+    @property
+    def dart_lines(self) -> list[np.ndarray]:
+        """The dart lines on the mould, mouth first, ``(k, 3)`` each."""
+        return [] if self.slits is None else self.slits.lines
+
+    @property
+    def max_shear_before(self) -> float:
+        return float(np.nanmax(np.abs(self.before.fields["shear_angle"])))
+
+    @property
+    def max_shear_after(self) -> float | None:
+        return None if not self.rounds else self.rounds[-1].max_shear
+
+    @property
+    def relieved(self) -> bool:
+        """Whether the largest shear ends below the locking angle (with or without darts)."""
+        final = self.after if self.after is not None else self.before
+        shear = self.max_shear_after if self.after is not None else self.max_shear_before
+        return bool(final.converged and shear < self.locking_angle)
+
+    def dart_pattern_lines(self) -> list[np.ndarray]:
+        """Both lips of every dart in the final pattern ``(k, 2)`` each: mouth → tip → mouth."""
+        if self.after is None or self.slits is None:
+            return []
+        X = self.after.material_coordinates
+        return [np.vstack([X[a], X[b][::-1][1:]]) for a, b in self.slits.lips]
+
+    def summary(self) -> dict[str, Any]:
+        """The numbers for a summary file."""
+        gaps = [] if self.after is None else self.slits.lip_gaps(self.after.material_coordinates)
+        return {
+            "locking_angle": self.locking_angle,
+            "max_shear_before": self.max_shear_before,
+            "max_shear_after": self.max_shear_after,
+            "relieved": self.relieved,
+            "darts": len(self.dart_lines),
+            "dart_lengths": [
+                float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for p in self.dart_lines
+            ],
+            "mouth_openings": [float(g[0]) for g in gaps],
+            "iterations_before": self.before.iterations,
+            "seconds_before": self.before.elapsed,
+            "rounds": [vars(r) for r in self.rounds],
+        }
+
+
+@takes_options(DartOptions)
+def solve_with_darts(
+    mesh: SurfaceMesh,
+    material: Hyperelastic,
+    thickness: float = 1.0,
+    *,
+    locking_angle: float,
+    polylines: Sequence[np.ndarray] | None = None,
+    options: DartOptions | None = None,
+    **settings: Any,
+) -> DartedPattern:
+    """Solve the pattern of ``mesh`` (:func:`vares.solve` with ``material`` and ``thickness``),
+    place darts where its shear reaches ``locking_angle`` (degrees) with ``darts="auto"``, or
+    open the dart lines ``polylines`` (``(k, 3)`` each, on or near the mould; e.g. a curves
+    file's, :func:`vares.io.curves.read_curves`), and solve again with the darts open, started
+    from the first pattern (module docs). Quads are split into triangles first.
+
+    ``options``: a :class:`DartOptions` to start from; keyword ``settings`` that are dart
+    options (below) change it, the others go to :func:`vares.solve` (e.g. ``warp_direction``).
+    """
+    dart_keys = DartOptions.specs()
+    (options,) = split_settings(
+        {k: v for k, v in settings.items() if k in dart_keys}, [options or DartOptions()]
+    )
+    solve_settings = {k: v for k, v in settings.items() if k not in dart_keys}
+    if options.dart_lines is not None and polylines is None:
+        raise ValueError("dart_lines names a file: pass its lines as polylines (read_curves)")
+    mesh = triangulated(mesh)
+    before = solve(mesh, material, thickness, **solve_settings)
+    result = DartedPattern(before, None, None, locking_angle)
+    if not before.converged or (polylines is None and options.darts == "none"):
+        return result
+    fibres = before.fibres
+    warp, fill = erected_yarns(mesh, before.material_coordinates, fibres.warp, fibres.fill)
+    shear = before.fields["shear_angle"]
+    plans: list[tuple[float | None, list[SurfaceLine] | None]]
+    if polylines is not None:
+        plans = [(None, darts_from_polylines(mesh, polylines))]
+    else:
+        if not np.nanmax(np.abs(shear)) >= locking_angle:
+            return result
+        fractions = [options.dart_tip - r * options.dart_step for r in range(options.dart_rounds)]
+        plans = [(max(f, 0.0) * locking_angle, None) for f in fractions]
+    locator = FaceLocator(mesh)
+    done: list[DartRound] = []
+    slits = after = None
+    for tip, lines in plans:
+        if lines is None:
+            lines = place_darts(
+                mesh, shear, warp, fill, locking_angle, tip, options.dart_max_length
+            )
+        if not lines:
+            break
+        slits = open_slits(mesh, lines)
+        start = _carried(locator, mesh, before.material_coordinates, slits.mesh.points)
+        clock = time.perf_counter()
+        after = solve(slits.mesh, material, thickness, **{**solve_settings, "initial_guess": start})
+        seconds = time.perf_counter() - clock
+        largest = float(np.nanmax(np.abs(after.fields["shear_angle"])))
+        lengths = [line.length for line in lines]
+        done.append(DartRound(tip, lengths, largest, after.iterations, seconds, after.converged))
+        if after.converged and largest < locking_angle:
+            break
+    return DartedPattern(before, after, slits, locking_angle, done)
+
+
+def _carried(
+    locator: FaceLocator, mesh: SurfaceMesh, coordinates: np.ndarray, points: np.ndarray
+) -> np.ndarray:
+    """The pattern ``coordinates`` of ``mesh`` read at ``points`` ``(k, 3)`` on it (linear in
+    the cell each lies in): the start of the solve with the darts open (their lips together)."""
+    faces, weights, _ = locator.locate(points)
+    return np.einsum("kc,kcd->kd", weights, coordinates[mesh.cells["triangle"][faces]])

@@ -1,0 +1,257 @@
+"""Darts: slits walked on the mould and opened, placed where a ply's shear reaches its locking
+angle, and the pattern solved again with them open (docs/composites.md, "Darts")."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from conftest import error_line, run
+
+from vares.analysis.darts import (
+    darts_from_polylines,
+    erected_yarns,
+    place_darts,
+    smoothed,
+    solve_with_darts,
+)
+from vares.geometry.cutting import cut_mesh
+from vares.geometry.examples import grid_cells, irregular_cap
+from vares.geometry.mesh import SurfaceMesh
+from vares.geometry.slits import open_slits, walk_line
+from vares.geometry.surface_lines import CuttingError
+
+R = 100.0
+LOCKING = 50.0
+
+
+def square(n: int = 10) -> SurfaceMesh:
+    """The unit square in the plane z = 0, ``n × n`` squares split into triangles."""
+    s = np.linspace(0.0, 1.0, n + 1)
+    x, y = np.meshgrid(s, s, indexing="xy")
+    return SurfaceMesh(
+        np.column_stack([x.ravel(), y.ravel(), 0 * x.ravel()]), grid_cells(n + 1, n + 1)
+    )
+
+
+def straight_up(mesh: SurfaceMesh, x: float, length: float):
+    """The line walked along +y from the bottom edge at ``x``."""
+    triangles = mesh.cells["triangle"]
+    points = mesh.points
+    for face, cell in enumerate(triangles):
+        for k in range(3):
+            a, b = points[cell[(k + 1) % 3]], points[cell[(k + 2) % 3]]
+            if a[1] == b[1] == 0.0 and min(a[0], b[0]) < x < max(a[0], b[0]):
+                weights = np.zeros(3)
+                t = (x - a[0]) / (b[0] - a[0])
+                weights[(k + 1) % 3], weights[(k + 2) % 3] = 1.0 - t, t
+                return walk_line(mesh, face, weights, lambda *_: np.array([0.0, 1.0, 0.0]), length)
+    raise AssertionError("no bottom edge there")
+
+
+def test_a_walked_line_is_straight_and_as_long_as_asked():
+    mesh = square(10)
+    line = straight_up(mesh, 0.43, 0.5)
+    assert np.abs(line.points[:, 0] - 0.43).max() < 1e-12
+    assert line.points[0, 1] == 0.0
+    # it stops at the first edge crossing beyond the length: within one cell's diagonal
+    assert 0.5 <= line.length < 0.5 + np.sqrt(2) * 0.1
+    # and stops before the boundary when the length is more than the square
+    through = straight_up(mesh, 0.43, 5.0)
+    assert through.points[-1, 1] < 1.0 and through.points[-1, 1] > 0.85
+
+
+def test_an_opened_slit_frees_both_lips_and_keeps_the_surface():
+    mesh = square(10)
+    line = straight_up(mesh, 0.43, 0.5)
+    slits = open_slits(mesh, [line])
+    opened = slits.mesh
+    cut = cut_mesh(mesh, [line], panels=False).mesh
+    chain = slits.lips[0][0]
+    # every node of the slit but its tip has a twin; the surface is the same
+    assert opened.num_points == cut.num_points + len(chain) - 1
+    assert opened.area == pytest.approx(1.0, abs=1e-12)
+    assert np.array_equal(slits.parent[: cut.num_points], np.arange(cut.num_points))
+    (gap,) = slits.lip_gaps(opened.points)
+    assert np.abs(gap).max() == 0.0  # on the mould the lips lie together
+    # one boundary loop: the square's edge and both lips of the slit
+    loops = opened.boundary_loops()
+    assert len(loops) == 1
+    ring = opened.points[loops[0]]
+    perimeter = np.linalg.norm(ring - np.roll(ring, -1, axis=0), axis=1).sum()
+    lip = np.linalg.norm(np.diff(opened.points[chain], axis=0), axis=1).sum()
+    assert lip == pytest.approx(line.length, rel=1e-12)
+    assert perimeter == pytest.approx(4.0 + 2.0 * lip, rel=1e-12)
+    # the two lips are the two sides of the line: twins and originals never share a cell
+    a, b = slits.lips[0]
+    cells = opened.cells["triangle"]
+    both = np.isin(cells, a[:-1]).any(axis=1) & np.isin(cells, b[:-1]).any(axis=1)
+    assert not both.any()
+
+
+def test_slits_that_are_no_darts_are_refused():
+    mesh = square(10)
+    through = straight_up(mesh, 0.43, 5.0)
+    # extended by hand to the top edge: it would cut the square in two
+    top = np.array([[0.43, 1.0, 0.0]])
+    from vares.geometry.surface_lines import EdgeLocator
+
+    whole = EdgeLocator(mesh).line(np.vstack([through.points, top]))
+    with pytest.raises(CuttingError, match="boundary to boundary"):
+        open_slits(mesh, [whole])
+    inside = EdgeLocator(mesh).line(through.points[2:])
+    with pytest.raises(CuttingError, match="does not start on the surface's boundary"):
+        open_slits(mesh, [inside])
+
+
+def test_dart_lines_given_as_points_are_drawn_onto_the_mould():
+    mesh = irregular_cap(R, 90.0, 20, 0.3, 1)
+    polar = np.radians(np.linspace(65.0, 90.0, 6))[::-1]  # the mouth at the equator first
+    azimuth = np.radians(45.0)
+    points = R * np.column_stack(
+        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)]
+    )
+    lifted = points * 1.01  # a little off the surface, as drawn in CAD
+    for given in (lifted, lifted[::-1]):  # either end first: the mouth is the boundary's
+        (line,) = darts_from_polylines(mesh, [given])
+        assert abs(line.points[0, 2]) < 1e-9  # on the equator
+        # in the meridian plane to within the faceting (cells of about 8 mm)
+        off = np.abs(line.points @ np.array([np.sin(azimuth), -np.cos(azimuth), 0.0]))
+        assert off.max() < 1.0
+        tip = np.degrees(np.arccos(line.points[-1, 2] / R))
+        assert 65.0 < tip < 72.0  # ends in the cell of the last point, or one short of it
+    with pytest.raises(CuttingError, match="from the mould"):
+        darts_from_polylines(mesh, [points * 1.5])
+
+
+def test_darts_follow_the_bisector_of_the_sheared_yarns():
+    """On the hemisphere with the warp along x the shear peaks on the 45° meridians at the
+    equator, and the bisector of the yarns' acute angle there is the meridian: four darts."""
+    from vares.geometry.drape import kinematic_drape
+
+    mesh = irregular_cap(R, 90.0, 20, 0.3, 1)
+    drape = kinematic_drape(mesh, [0, 0, R], [1, 0, 0], 2.0)
+    lines = place_darts(mesh, drape.shear_angle, drape.warp, drape.fill, 48.0, 40.0)
+    assert len(lines) == 4
+    for line in lines:
+        mouth = np.degrees(np.arctan2(line.points[0, 1], line.points[0, 0]))
+        assert abs((mouth - 45.0 + 45.0) % 90.0 - 45.0) < 6.0  # two boundary edges of 3°
+        azimuth = np.degrees(np.arctan2(line.points[:, 1], line.points[:, 0]))
+        assert np.ptp(azimuth) < 6.0  # along a meridian
+        assert abs(line.points[-1, 2]) > 10.0  # well inside
+    assert place_darts(mesh, drape.shear_angle, drape.warp, drape.fill, 60.0, 40.0) == []
+
+
+def test_erected_yarns_of_the_surface_itself_are_its_axes():
+    mesh = square(4)
+    warp, fill = erected_yarns(mesh, mesh.points[:, :2], np.array([1.0, 0.0]), np.array([0, 1.0]))
+    assert np.allclose(warp, [1, 0, 0]) and np.allclose(fill, [0, 1, 0])
+    field = np.arange(mesh.num_cells, dtype=float)
+    assert smoothed(mesh, np.full(mesh.num_cells, 3.0)) == pytest.approx(3.0)
+    assert smoothed(mesh, field).max() < field.max()
+
+
+@pytest.fixture(scope="module")
+def hemisphere_darts():
+    from vares.materials import NonCrimpFabric
+
+    mesh = irregular_cap(R, 90.0, 20, 0.3, 1)
+    law = NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5])
+    darted = solve_with_darts(
+        mesh, law, locking_angle=LOCKING, darts="auto", warp_direction=(1.0, 0.0, 0.0)
+    )
+    return mesh, law, darted
+
+
+def test_darts_bring_the_hemisphere_below_the_locking_angle(hemisphere_darts):
+    """The test that fails if a dart does not open: the lips separate in the flat pattern and
+    the largest shear drops below the locking angle (measured 56.7° → 49.3°, mouths 14–23 mm)."""
+    _, _, darted = hemisphere_darts
+    assert darted.before.converged and darted.after.converged
+    assert darted.max_shear_before > LOCKING + 5.0
+    assert darted.relieved and darted.max_shear_after < LOCKING
+    assert darted.max_shear_before - darted.max_shear_after > 5.0
+    assert len(darted.dart_lines) == 4
+    for gaps in darted.slits.lip_gaps(darted.after.material_coordinates):
+        assert gaps[0] > 10.0  # the mouth opens (mm)
+        assert gaps[-1] == 0.0  # the tip is one node
+        assert np.all(np.diff(gaps) < 1.0)  # closing from the mouth to the tip
+    # the darts' lips meet again when the pattern is erected: the mesh is the mould's surface
+    assert darted.after.mesh.area == pytest.approx(darted.before.mesh.area, rel=1e-9)
+    assert not darted.after.overlap
+
+
+def test_a_dart_that_is_cut_but_not_opened_relieves_nothing(hemisphere_darts):
+    """The same lines made edges of the mesh, the lips left joined: the shear stays beyond the
+    locking angle, so the relief above is the opening's, not the new mesh's."""
+    import vares
+    from vares.geometry.surface_lines import EdgeLocator
+
+    mesh, law, darted = hemisphere_darts
+    locate = EdgeLocator(mesh, tolerance=1e-6 * R)
+    closed = cut_mesh(mesh, [locate.line(line) for line in darted.dart_lines], panels=False).mesh
+    assert closed.num_points == darted.slits.parent.max() + 1  # the mesh the darts were cut in
+    result = vares.solve(closed, law, warp_direction=(1.0, 0.0, 0.0))
+    assert result.converged
+    assert np.abs(result.fields["shear_angle"]).max() > LOCKING
+
+
+def test_drape_command_with_dart_lines(tmp_path):
+    import ezdxf
+    import meshio
+
+    from vares.io.meshes import write_surface
+
+    mesh = irregular_cap(R, 90.0, 20, 0.3, 1)
+    surface = tmp_path / "hemisphere.obj"
+    write_surface(surface, mesh)
+    curves = tmp_path / "darts.txt"
+    text = []
+    for azimuth in np.radians([45.0, 135.0, 225.0, 315.0]):
+        polar = np.radians([90.0, 62.0])
+        for p in polar:
+            x = R * np.array([np.sin(p) * np.cos(azimuth), np.sin(p) * np.sin(azimuth), np.cos(p)])
+            text.append(" ".join(f"{v:.9g}" for v in x))
+        text.append("")
+    curves.write_text("\n".join(text))
+    out = tmp_path / "out"
+    base = ["drape", surface, "--seed", "0,0,100", "--warp", "1,0,0", "--spacing", 4, "-o", out]
+    ncf = ["--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
+    result = run(*base, "--dart-lines", curves, *ncf)
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "drape.json").read_text())["darts"]
+    assert data["darts"] == 4 and data["max_shear_after"] < data["max_shear_before"] - 4.0
+    assert min(data["mouth_openings"]) > 10.0
+    layers = [e.dxf.layer for e in ezdxf.readfile(out / "pattern.dxf").modelspace()]
+    assert layers.count("DART") == 4 and layers.count("SEAM") == 1
+    opened = meshio.read(out / "darts.vtu")
+    assert len(opened.points) > mesh.num_points
+    assert (out / "darts.png").stat().st_size > 10_000
+    for extra, message in [
+        ([], "darts need the ply's fabric"),
+        (["--darts", "auto", *ncf], "not both"),
+        (
+            [
+                "--material",
+                "orthotropic",
+                "--E1",
+                "1000",
+                "--E2",
+                "1000",
+                "--G12",
+                "1",
+                "--nu12",
+                "0",
+                "--units",
+                "furlong",
+            ],
+            "--units",
+        ),
+    ]:
+        refused = run(*base[:-1], tmp_path / "refused", "--dart-lines", curves, *extra)
+        assert refused.exit_code == 2 and message in error_line(refused), refused.stderr
+    refused = run(*base[:-1], tmp_path / "refused", *ncf)
+    assert refused.exit_code == 2 and "add --darts auto" in error_line(refused)
+    refused = run(*base[:-1], tmp_path / "refused", "--darts", "auto", "--material", "neo-hooke")
+    assert refused.exit_code == 2 and "yarns" in error_line(refused)
