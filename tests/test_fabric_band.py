@@ -153,3 +153,21 @@ def test_fabric_fit_report_names_each_load_ratio(tmp_path):
     assert text.count("<img") == 8 and "compensation per cycle" in text
     wrong = run("fabric", "fit", *paths, "-o", tmp_path / "y.toml", "--report", tmp_path / "r.pdf")
     assert wrong.exit_code == 2 and "--report must end in .html" in error_line(wrong)
+
+
+def test_samples_on_a_dask_scheduler_are_those_solved_here(strips, batch):
+    distributed = pytest.importorskip("dask.distributed")
+    options = ScatterOptions(samples=2, seed=1)
+    here = fabric_band(strips, batch, scatter=options, erected=False, **SETTINGS)
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        there = fabric_band(
+            strips,
+            batch,
+            scatter=options,
+            erected=False,
+            scheduler=cluster.scheduler_address,
+            **SETTINGS,
+        )
+    assert there.band.samples == here.band.samples
