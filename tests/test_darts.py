@@ -218,7 +218,7 @@ def test_drape_command_with_dart_lines(tmp_path):
     out = tmp_path / "out"
     base = ["drape", surface, "--seed", "0,0,100", "--warp", "1,0,0", "--spacing", 4, "-o", out]
     ncf = ["--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
-    result = run(*base, "--dart-lines", curves, *ncf)
+    result = run(*base, "--dart-lines", curves, *ncf, "--report")
     assert result.exit_code == 0, result.stderr
     data = json.loads((out / "drape.json").read_text())["darts"]
     assert data["darts"] == 4 and data["max_shear_after"] < data["max_shear_before"] - 4.0
@@ -228,6 +228,9 @@ def test_drape_command_with_dart_lines(tmp_path):
     opened = meshio.read(out / "darts.vtu")
     assert len(opened.points) > mesh.num_points
     assert (out / "darts.png").stat().st_size > 10_000
+    html = (out / "drape.html").read_text()
+    assert 'id="dart-lines"' in html and 'id="figure-darts"' in html
+    assert html.count("<tr>", html.index('id="dart-lines"')) >= 5  # a header, four darts
     for extra, message in [
         ([], "darts need the ply's fabric"),
         (["--darts", "auto", *ncf], "not both"),

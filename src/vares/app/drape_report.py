@@ -1,22 +1,26 @@
 """The report's section on a ply draped kinematically beside the pattern (``--drape``): where it
-was laid, its producibility, its shear against the pattern's and the net's shear on the surface."""
+was laid, its producibility, its shear against the pattern's and the net's shear on the surface;
+and the report of ``vares drape --report`` (drape.html): the same drape and its darts, drawn on
+the mould and on the flat pattern."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from .html_parts import REPORT_DPI, figure, number, table
+from .html_parts import REPORT_DPI, figure, number, page, status_text, table
 from .outcome import PanelOutcome
 
-__all__ = ["drape_section"]
+if TYPE_CHECKING:
+    from ..analysis.darts import DartedPattern
+    from ..analysis.drape import PlyDrape
+
+__all__ = ["darts_section", "drape_page", "drape_section"]
 
 
-def drape_section(panel: PanelOutcome) -> list[str]:
-    """The HTML parts of the section (none without a drape)."""
-    ply = panel.drape
-    if ply is None:
-        return []
-    check, units = ply.producibility, panel.units
+def _ply_rows(ply: PlyDrape, units: str) -> list[tuple[str, object]]:
+    check = ply.producibility
     locking, source = ply.options.locking
     rows = [
         ("seed", " ".join(number(v, 6) for v in ply.seed)),
@@ -30,9 +34,17 @@ def drape_section(panel: PanelOutcome) -> list[str]:
         ("area with a shear value", f"{100 * check.covered:.1f} %"),
     ]
     rows += [(f"area {name}", f"{100 * value:.2f} %") for name, value in check.fractions.items()]
+    return rows
+
+
+def drape_section(panel: PanelOutcome) -> list[str]:
+    """The HTML parts of the section (none without a drape)."""
+    ply = panel.drape
+    if ply is None:
+        return []
     parts = [
         "<h2>Kinematic drape and producibility</h2>",
-        table(rows, ident="drape"),
+        table(_ply_rows(ply, panel.units), ident="drape"),
     ]
     result = panel.result
     if result.converged:
@@ -61,3 +73,79 @@ def drape_section(panel: PanelOutcome) -> list[str]:
     ):
         parts.append(figure(drawing, titles["shear_angle"], "figure-drape-shear", close=False))
     return parts
+
+
+def darts_section(darted: DartedPattern, units: str) -> list[str]:
+    """The HTML parts on a ply's darts: the largest shear before and after, every dart's length
+    and mouth opening, every solve with darts, and the shear on the mould and the flat pattern
+    with the dart lines."""
+    summary = darted.summary()
+    after = summary["max_shear_after"]
+    rows = [
+        ("locking angle", f"{number(darted.locking_angle, 4)}°"),
+        ("largest shear without darts", f"{number(summary['max_shear_before'], 4)}°"),
+        (
+            "largest shear with the darts open",
+            "no dart" if after is None else f"{number(after, 4)}°",
+        ),
+        ("below the locking angle", "yes" if darted.relieved else "no"),
+        ("darts", summary["darts"]),
+        ("pattern without darts", _state(darted.before)),
+        (
+            "pattern with the darts open",
+            "not solved" if darted.after is None else _state(darted.after),
+        ),
+    ]
+    parts = ["<h2>Darts</h2>", table(rows, ident="darts")]
+    if summary["darts"]:
+        darts = [
+            (str(k), f"{number(length, 4)} {units}", f"{number(opening, 4)} {units}")
+            for k, (length, opening) in enumerate(
+                zip(summary["dart_lengths"], summary["mouth_openings"], strict=True), start=1
+            )
+        ]
+        parts.append(table(darts, header=("dart", "length", "mouth opening"), ident="dart-lines"))
+    rounds = [
+        (
+            str(k),
+            "given" if r["tip_angle"] is None else f"{number(r['tip_angle'], 4)}°",
+            f"{number(r['max_shear'], 4)}°",
+            r["iterations"],
+            f"{r['seconds']:.1f} s",
+            "yes" if r["converged"] else "no",
+        )
+        for k, r in enumerate(summary["rounds"], start=1)
+    ]
+    if rounds:
+        header = ("solve", "dart tip", "largest shear", "iterations", "time", "converged")
+        parts.append(table(rounds, header=header, ident="dart-rounds"))
+    from ..io.dart_plots import plot_darts  # when a report is written
+
+    caption = "shear on the mould without and with the darts open, and the flat pattern"
+    parts.append(figure(plot_darts(darted, dpi=REPORT_DPI), caption, "figure-darts"))
+    return parts
+
+
+def _state(result) -> str:
+    return "converged" if result.converged else f"not converged: {result.reason}"
+
+
+def drape_page(ply: PlyDrape, darted: DartedPattern | None, name: str, units: str) -> str:
+    """The report of ``vares drape --report``: the drape and producibility of the ply on the
+    mould ``name`` and, with darts, :func:`darts_section`."""
+    warnings = []
+    if darted is not None and not darted.relieved:
+        warnings.append("the largest shear is not below the locking angle")
+    status = (
+        "drape"
+        if darted is None
+        else status_text(
+            (darted.after or darted.before).converged, (darted.after or darted.before).reason
+        )
+    )
+    parts = page(name, f"Drape: {name}", status, warnings)
+    parts += ["<h2>Kinematic drape and producibility</h2>", table(_ply_rows(ply, units))]
+    if darted is not None:
+        parts += darts_section(darted, units)
+    parts.append("</body></html>")
+    return "\n".join(parts)

@@ -29,6 +29,14 @@ OUTPUT_FLAGS = [
         panel="Output",
     ),
     option_parameter(
+        "report",
+        False,
+        bool,
+        "--report",
+        help="Also write drape.html: the producibility, the darts and their pictures.",
+        panel="Output",
+    ),
+    option_parameter(
         "units",
         "mm",
         str,
@@ -80,6 +88,8 @@ def drape(
         dart_paths = [output / "darts.vtu", output / "pattern.dxf", output / "darts.png"]
         if darting.wanted:
             paths += dart_paths
+        if values["report"]:
+            paths.append(output / "drape.html")
         folder = OutputFolder(
             output, paths, force=values["force"], inputs=[surface], command="drape"
         )
@@ -117,6 +127,11 @@ def drape(
             write_json(folder.staged(paths[0]), data)
             if darted is not None:
                 _write_darts(folder, dart_paths, darted, values["units"], surface.stem)
+            if values["report"]:
+                from ..drape_report import drape_page
+
+                html = drape_page(ply, darted, surface.stem, values["units"])
+                folder.staged(paths[-1]).write_text(html, encoding="utf-8")
             folder.commit()
         finally:
             folder.discard()
