@@ -66,7 +66,8 @@ def _blank_figure(blank: PlyBlank, units: str):
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
+    fig, ax = plt.subplots(figsize=(6.5, 5.0))
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.1, top=0.92)
     ax.add_collection(
         PolyCollection(_polygons(blank), facecolor="#e3e8ef", edgecolor="none", antialiased=False)
     )
@@ -83,7 +84,10 @@ def _blank_figure(blank: PlyBlank, units: str):
             xytext=tuple(blank.origin),
             arrowprops=dict(arrowstyle="-|>", color=colour, lw=2.0),
         )
-        ax.text(*(blank.origin + 1.12 * d), text, color=colour, ha="center", va="center")
+        u = d / np.linalg.norm(d)
+        ha = "left" if u[0] > 0.3 else "right" if u[0] < -0.3 else "center"
+        va = "bottom" if u[1] > 0.3 else "top" if u[1] < -0.3 else "center"
+        ax.text(*(blank.origin + 1.05 * d), text, color=colour, ha=ha, va=va)
     ax.plot(*blank.origin, "o", color="black", ms=4)
     ax.set_title(f"{blank.name}: flat blank, net (black) and trim (red, +{blank.allowance:g})")
     ax.set_xlabel(f"along the warp [{units}]")
@@ -97,7 +101,8 @@ def _producibility_figure(blank: PlyBlank, check: Producibility):
     from matplotlib.patches import Patch
 
     colours = {name: c for name, c in zip(CLASSES, _CLASS_COLOURS, strict=True)}
-    fig, ax = plt.subplots(figsize=(6.5, 5.0), layout="constrained")
+    fig, ax = plt.subplots(figsize=(6.5, 5.0))
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.1, top=0.92)
     faces = [colours[c] for c in check.classes]
     ax.add_collection(
         PolyCollection(_polygons(blank), facecolor=faces, edgecolor="none", antialiased=False)
@@ -112,7 +117,7 @@ def _producibility_figure(blank: PlyBlank, check: Producibility):
         Patch(color=colours[n], label=f"{labels[n]}: {100 * check.fractions[n]:.1f} %")
         for n in CLASSES[:3]
     ]
-    ax.legend(handles=handles, loc="upper right", fontsize=8)
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.06), ncols=3, fontsize=8)
     ax.set_title(f"{blank.name}: producibility (shear against the locking angle)")
     return fig
 
