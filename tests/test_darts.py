@@ -88,6 +88,10 @@ def test_an_opened_slit_frees_both_lips_and_keeps_the_surface():
     cells = opened.cells["triangle"]
     both = np.isin(cells, a[:-1]).any(axis=1) & np.isin(cells, b[:-1]).any(axis=1)
     assert not both.any()
+    # the left lip keeps the nodes: seen from +z, left of a slit running along +y is x < 0.43
+    centroids = opened.points[cells].mean(axis=1)
+    assert np.all(centroids[np.isin(cells, a[:-1]).any(axis=1), 0] < 0.43)
+    assert np.all(centroids[np.isin(cells, b[:-1]).any(axis=1), 0] > 0.43)
 
 
 def test_slits_that_are_no_darts_are_refused():

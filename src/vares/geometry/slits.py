@@ -106,7 +106,8 @@ class SlitMesh:
 
     ``mesh``: the opened surface (triangles); ``parent`` ``(n,)``: for every node, the node of
     the cut mesh it is (itself, or the node a twin was made of); ``lips``: per slit, the node
-    chains ``(k,)`` of its two lips from the mouth (on the boundary) to the shared tip;
+    chains ``(k,)`` of its two lips from the mouth (on the boundary) to the shared tip, the
+    left lip (as the slit runs in from the mouth, seen along the cells' normal) first;
     ``cell_origin`` ``(m,)``: the cell of the input mesh every cell lies in; ``lines``: the
     slits as walked (3D polylines ``(k, 3)``).
     """
@@ -157,14 +158,14 @@ def open_slits(mesh: SurfaceMesh, lines: Sequence[SurfaceLine], snap: float = SN
     lips = []
     for chain in chains:
         twins = []
-        for node in chain[:-1].tolist():
-            twin = _twin(cells, int(node), slit_edges, len(new_points))
+        for node, following in itertools.pairwise(chain.tolist()):
+            twin = _twin(cells, node, following, slit_edges, len(new_points))
             if twin is None:
                 raise CuttingError(
                     f"the slit through {points[node]} does not divide the cells there"
                 )
             new_points.append(points[node])
-            parent.append(int(node))
+            parent.append(node)
             twins.append(twin)
         lips.append((np.array(chain), np.array([*twins, int(chain[-1])])))
     opened = SurfaceMesh(np.array(new_points), {"triangle": cells})
@@ -173,9 +174,11 @@ def open_slits(mesh: SurfaceMesh, lines: Sequence[SurfaceLine], snap: float = SN
     return SlitMesh(opened, np.array(parent), lips, origin, [c.points for c in lines])
 
 
-def _twin(cells: np.ndarray, node: int, slit_edges: set, twin: int) -> int | None:
-    """Give the cells on one side of the slit at ``node`` the new node ``twin`` (in place); None
-    when the slit does not divide the cells around the node in two."""
+def _twin(cells: np.ndarray, node: int, following: int, slit_edges: set, twin: int) -> int | None:
+    """Give the cells at ``node`` on the right of the slit (as it runs on to ``following``) the
+    new node ``twin`` (in place): the node's cells on the left, where the slit's piece runs
+    ``node → following`` in the cell's own order, keep the node, so every lip is one side's.
+    None when the slit does not divide the cells around the node in two."""
     around = np.flatnonzero((cells == node).any(axis=1))
     label = {int(c): i for i, c in enumerate(around)}
     root = list(range(len(around)))
@@ -197,7 +200,15 @@ def _twin(cells: np.ndarray, node: int, slit_edges: set, twin: int) -> int | Non
     groups = {find(i) for i in range(len(around))}
     if len(groups) != 2:
         return None
-    side = find(0)
+    left = [
+        c
+        for c in around.tolist()
+        if following in cells[c]
+        and cells[c][(int(np.flatnonzero(cells[c] == node)[0]) + 1) % 3] == following
+    ]
+    if len(left) != 1:
+        return None
+    side = find(label[left[0]])
     for i, cell in enumerate(around.tolist()):
         if find(i) != side:
             cells[cell][cells[cell] == node] = twin

@@ -14,9 +14,9 @@ __all__ = ["plot_darts"]
 
 def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
     """The shear magnitude (degrees) on the mould without darts and with the darts open (an
-    oblique view, dart lines in black) and on the flat pattern with its darts' lips, one colour
-    scale from 0 to the larger of the largest shear and the locking angle; cells at or beyond
-    the locking angle in red."""
+    oblique view, the dart lines on the side seen in black) and on the flat pattern with its
+    darts' lips, one colour scale from 0 to the larger of the largest shear and the locking
+    angle; cells at or beyond the locking angle in red."""
     from matplotlib.colors import Normalize
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
@@ -37,23 +37,42 @@ def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
     if after is not None:
         moulds.append((after, darted.dart_lines, "darts open"))
     for index, (result, lines, title) in enumerate(moulds, start=1):
-        ax = fig.add_subplot(1, count, index, projection="3d")
+        ax = fig.add_subplot(1, count, index, projection="3d", computed_zorder=False)
         mesh = result.mesh
         corners = mesh.points[mesh.cells["triangle"]]
         ax.add_collection3d(
-            Poly3DCollection(corners, facecolors=faces(result.fields["shear_angle"]), linewidths=0)
+            Poly3DCollection(
+                corners,
+                facecolors=faces(result.fields["shear_angle"]),
+                edgecolors=faces(result.fields["shear_angle"]),
+                linewidths=0.2,
+                zorder=1,
+            )
         )
         size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
-        if lines:
-            lifted = [line + 0.01 * size * _outward(mesh, line) for line in lines]
-            segments = [np.stack([p[:-1], p[1:]], axis=1) for p in lifted]
-            ax.add_collection3d(Line3DCollection(np.vstack(segments), colors="k", linewidths=2.0))
+        elevation, azimuth = np.radians(25.0), np.radians(-60.0)
+        towards = np.array(
+            [
+                np.cos(elevation) * np.cos(azimuth),
+                np.cos(elevation) * np.sin(azimuth),
+                np.sin(elevation),
+            ]
+        )
+        segments = []
+        for line in lines:  # the parts on the side seen, lifted off the surface a little
+            normals = _outward(mesh, line)
+            lifted = line + 0.01 * size * normals
+            seen = (normals @ towards > 0)[:-1] & (normals @ towards > 0)[1:]
+            segments.append(np.stack([lifted[:-1], lifted[1:]], axis=1)[seen])
+        if segments:
+            ax.add_collection3d(
+                Line3DCollection(np.vstack(segments), colors="k", linewidths=2.0, zorder=2)
+            )
         low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
-        middle, half = 0.5 * (low + high), 0.5 * float(np.max(high - low))
-        for axis, centre in zip("xyz", middle, strict=True):
-            getattr(ax, f"set_{axis}lim")(centre - half, centre + half)
-        ax.set_box_aspect((1, 1, 1))
-        ax.view_init(elev=30.0, azim=-60.0)
+        for axis, a, b in zip("xyz", low, high, strict=True):
+            getattr(ax, f"set_{axis}lim")(a, b)
+        ax.set_box_aspect(np.maximum(high - low, 1e-3 * float(np.max(high - low))), zoom=1.3)
+        ax.view_init(elev=np.degrees(elevation), azim=np.degrees(azimuth))
         largest = float(np.nanmax(np.abs(result.fields["shear_angle"])))
         ax.set_title(f"{title}\nlargest shear {largest:.1f}°", fontsize=10)
         ax.set_axis_off()
@@ -64,7 +83,12 @@ def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
         from matplotlib.collections import PolyCollection
 
         ax.add_collection(
-            PolyCollection(corners, facecolors=faces(after.fields["shear_angle"]), linewidths=0)
+            PolyCollection(
+                corners,
+                facecolors=faces(after.fields["shear_angle"]),
+                edgecolors="face",
+                linewidths=0.2,
+            )
         )
         for lips in darted.dart_pattern_lines():
             ax.plot(lips[:, 0], lips[:, 1], "k-", linewidth=1.2)

@@ -1,0 +1,117 @@
+"""Darts where a ply's shear reaches its locking angle (issue 22, item 4).
+
+A woven or stitched ply draped over a mould from the pole with the warp along x
+(``vares.analysis.darts.solve_with_darts``, ``darts="auto"``): the pattern solved without darts,
+darts placed where its shear reaches the locking angle and lengthened round by round until the
+largest shear is below it. Printed per mould: the largest shear before and after, the darts'
+number, lengths and mouth openings (the gap between the lips at the boundary in the flat
+pattern), every round's tip angle, largest shear, Newton iterations and seconds; and the control
+(``--control``): the last round's dart lines made edges of the mesh but not opened.
+
+Moulds: ``hemisphere`` (``irregular_cap(100, 90, rings, 0.3, 1)``, R = 100 mm to the equator),
+``rib30`` (the shipped rib, warp along the rib); laws: ``ncf`` (the README's non-crimp fabric,
+``NonCrimpFabric([-250, 250], [-250, 250], [0.5])``) and ``woven`` (orthotropic, E/G = 1e4).
+
+    python benchmarks/darts.py --rings 20 30 40 --control --picture docs/images
+    python benchmarks/darts.py --mould rib30 --locking 50 4
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from vares.analysis.darts import solve_with_darts
+from vares.geometry.cutting import cut_mesh
+from vares.geometry.examples import irregular_cap, rib30
+from vares.geometry.surface_lines import EdgeLocator
+from vares.materials import NonCrimpFabric, OrthotropicStVenantKirchhoff
+
+LAWS = {
+    "ncf": lambda: NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5]),
+    "woven": lambda: OrthotropicStVenantKirchhoff(E1=1e4, E2=1e4, G12=1.0, nu12=0.0),
+}
+
+
+def mould(name: str, rings: int):
+    """The mesh and the warp direction."""
+    if name == "hemisphere":
+        return irregular_cap(100.0, 90.0, rings, 0.3, 1), (1.0, 0.0, 0.0)
+    return rib30(), (0.0, 1.0, 0.0)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--mould", choices=("hemisphere", "rib30"), default="hemisphere")
+    parser.add_argument("--rings", type=int, nargs="+", default=[30])
+    parser.add_argument("--law", choices=tuple(LAWS), nargs="+", default=["ncf"])
+    parser.add_argument("--locking", type=float, nargs="+", default=[50.0])
+    parser.add_argument("--control", action="store_true", help="solve the darts cut but closed")
+    parser.add_argument("--picture", type=Path, help="folder for darts_<mould>.png")
+    args = parser.parse_args()
+    rings_list = args.rings if args.mould == "hemisphere" else [0]
+    for rings in rings_list:
+        mesh, warp = mould(args.mould, rings)
+        for law in args.law:
+            for locking in args.locking:
+                clock = time.perf_counter()
+                darted = solve_with_darts(
+                    mesh, LAWS[law](), locking_angle=locking, darts="auto", warp_direction=warp
+                )
+                total = time.perf_counter() - clock
+                s = darted.summary()
+                print(
+                    f"\n{args.mould} {rings or ''} ({mesh.num_cells} cells), {law}, locking "
+                    f"{locking:g}°: before {s['max_shear_before']:.2f}° "
+                    f"({s['iterations_before']} it, {s['seconds_before']:.1f} s); "
+                    f"total {total:.1f} s"
+                )
+                for r in s["rounds"]:
+                    lengths = ", ".join(f"{v:.1f}" for v in r["lengths"])
+                    print(
+                        f"  tip {r['tip_angle']:.1f}°: darts {lengths}; largest shear "
+                        f"{r['max_shear']:.2f}°, {r['iterations']} it, {r['seconds']:.1f} s, "
+                        f"converged {r['converged']}"
+                    )
+                if darted.after is not None:
+                    openings = ", ".join(f"{v:.1f}" for v in s["mouth_openings"])
+                    print(
+                        f"  after: {s['darts']} darts, largest shear {s['max_shear_after']:.2f}°, "
+                        f"relieved {s['relieved']}, mouth openings {openings}"
+                    )
+                    for line in darted.dart_lines:
+                        mouth, tip = line[0], line[-1]
+                        print(
+                            f"    dart from {np.round(mouth, 2).tolist()} to "
+                            f"{np.round(tip, 2).tolist()}, azimuth "
+                            f"{np.degrees(np.arctan2(mouth[1], mouth[0])):.1f}°"
+                        )
+                if args.control and darted.after is not None:
+                    locate = EdgeLocator(mesh, tolerance=1e-6 * float(np.ptp(mesh.points)))
+                    lines = [locate.line(line) for line in darted.dart_lines]
+                    closed = cut_mesh(mesh, lines, panels=False).mesh
+                    from vares import solve
+
+                    result = solve(closed, LAWS[law](), warp_direction=warp)
+                    largest = float(np.abs(result.fields["shear_angle"]).max())
+                    print(
+                        f"  control, the darts cut but not opened: largest shear {largest:.2f}°, "
+                        f"converged {result.converged}, {result.iterations} it"
+                    )
+                if args.picture is not None and darted.after is not None:
+                    import matplotlib.pyplot as plt
+
+                    from vares.io.dart_plots import plot_darts
+
+                    figure = plot_darts(darted)
+                    path = args.picture / f"darts_{args.mould}.png"
+                    figure.savefig(path)
+                    plt.close(figure)
+                    print(f"  wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
