@@ -351,3 +351,18 @@ def test_cli_prints_the_plies_and_the_yield(job_run, tmp_path):
     assert "plies as cut" in done.stderr
     again = run("laminate", folder / "job.toml", "-o", tmp_path / "cli", "-q")
     assert again.exit_code == 2 and "--force" in error_line(again)
+
+
+def test_ply_book_without_weights_or_roll_says_so(laminate, blanks):
+    from dataclasses import replace
+
+    from vares.app.ply_book import ply_book
+
+    light = [replace(b, areal_weight=None, thickness=None) for b in blanks]
+    page = ply_book(laminate, light, None, units="m", title="cap")
+    assert "no areal weight for some plies: their masses are not shown" in page
+    assert "<p id='nest'>Not nested: the laminate names no roll_width.</p>" in page
+    assert "<p id='total-mass'>Total mass of the nets: –.</p>" in page
+    assert "<p id='total-thickness'>Total thickness: –.</p>" in page
+    assert page.count("<section class='ply'") == 4
+    assert page.count("data:image/png;base64,") == 3 * 4
