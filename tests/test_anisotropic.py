@@ -248,15 +248,15 @@ def test_a_free_pattern_turns_to_where_turning_the_yarns_costs_nothing():
     """A non-crimp fabric on a flat hypar whose energy turns the pattern some 25° from the
     held one: the free pattern is where the energy is stationary under turning the yarns
     (checked by differences of the energy, independently of the solver's residual), found
-    by globalised Newton alone (it took 283 iterations and a pseudo-time fallback when the
-    line search's steps turned the pattern linearly)."""
+    by globalised Newton with the held rotation and then the rotation as an unknown (it took
+    283 iterations and a pseudo-time fallback when the line search's steps turned the pattern
+    linearly, 31 when they turned it by their least-squares turn)."""
     mesh = hypar(size=10.0, rise=0.06, n=24)
     held = vares.solve(mesh, NCF, warp_angle=20.0)
     free = vares.solve(mesh, NCF, warp_angle=20.0, orientation="free")
     assert held.converged and free.converged, free.reason
-    assert free.strategy == ["globalised newton"] and free.iterations < 40  # 48 not turned further
-    # where the projected tangent fell short, the turn was taken further (48 iterations without)
-    assert "projected, turned" in {r.tangent for r in free.history}
+    assert free.strategy == ["globalised newton", "free rotation"]
+    assert free.iterations <= held.iterations + 10  # 6 held, 15 free
     assert free.energy < 0.7 * held.energy
     scale = free.energy  # dE/dθ of the held pattern is of the energy's order
     assert abs(_fibre_torque(mesh, NCF, held.material_coordinates, held.fibres)) > 0.1 * scale

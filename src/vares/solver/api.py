@@ -28,12 +28,17 @@ from .newton import Failure, NewtonContext, describe_cells
 from .options import SolveOptions
 from .result import IterationRecord, PatternResult
 from .start import Start, initial_guess
-from .strategies import follow_plan, plan
+from .strategies import follow_plan, plan, turn_free
 
 __all__ = ["solve"]
 
 #: Energy changes below this fraction of stiffness × thickness × area are round-off.
 ENERGY_NOISE = 1e-13
+#: A pattern free to turn is solved with its rotation held to this relative residual (or the
+#: solve's tolerance, if looser) before it is let turn: where the globalised Newton's exact
+#: tangents take over (closer, its steps gain little that the turn does not undo; from
+#: further, the turning steps start off the valley floor; benchmarks/free_orientation.py).
+HELD_FIRST = 1e-2
 
 
 @takes_options(SolveOptions)
@@ -221,7 +226,12 @@ class _Run:
                 fibres = initial_fibres(fibres, options.warp_angle, x, problem, direction)
                 problem = self.problem(fibres)
             attempts = plan(options.strategy, options.steps, start.plane is not None)
-            x, path, reason = follow_plan(problem, x, start.plane, attempts, ctx, options.damping)
+            if rotation == "free":
+                x, path, reason = self._free(problem, start, attempts, ctx)
+            else:
+                x, path, reason = follow_plan(
+                    problem, x, start.plane, attempts, ctx, options.damping
+                )
             self.path += path
             if reason is None and direction is not None:
                 self.path.append("warp alignment")
@@ -241,6 +251,24 @@ class _Run:
         if misfit is not None:
             reason = misfit.describe()
         return _Attempt(start, x, problem, fibres, rotation, reason, deviation, overlap, misfit)
+
+    def _free(self, problem: Problem, start: Start, attempts, ctx: NewtonContext):
+        """A pattern free to turn: solved first with the rotation of ``start`` held, then let
+        turn (:func:`~vares.solver.strategies.turn_free`); where the held solve fails, the
+        attempts free to turn from ``start``. ``(pattern, names tried, reason or None)``."""
+        damping = self.options.damping
+        held = self._context(problem, start, "held")
+        held.residual_tolerance = max(held.residual_tolerance, HELD_FIRST * held.force_scale)
+        x, path, reason = follow_plan(
+            problem, start.coordinates, start.plane, attempts, held, damping
+        )
+        if reason is None:
+            x, more, reason = turn_free(problem, x, ctx, damping)
+            return x, path + more, reason
+        x, more, reason = follow_plan(
+            problem, start.coordinates, start.plane, attempts, ctx, damping
+        )
+        return x, path + more, reason
 
     def _context(self, problem: Problem, start: Start, rotation: str) -> NewtonContext:
         free, constraint = rigid_modes(start.coordinates, rotation)

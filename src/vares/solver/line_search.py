@@ -38,6 +38,16 @@ class StepPath:
             self.turn = float(np.sum(direction * across)) / norm
             self.rest = direction - self.turn * across
 
+    @classmethod
+    def turning(cls, x: np.ndarray, rest: np.ndarray, pivot: int, turn: float) -> StepPath:
+        """The path ``p + R(α turn)(x + α rest − p)`` about node ``pivot`` (``p``), its turn
+        given (radians per unit step) rather than taken from a step by least squares."""
+        path = cls(x, rest, None)
+        path.centre = x[pivot]
+        path.arm = x - path.centre
+        path.turn = float(turn)
+        return path
+
     def at(self, alpha: float, turned: float | None = None) -> np.ndarray:
         """The point ``α`` along the step, its turn ``turned`` times the step's (default α)."""
         if self.turn == 0.0:

@@ -28,6 +28,7 @@ from .line_search import LineSearch
 from .linear import LinearSolver, SingularMatrixError
 from .result import IterationRecord, StepRecord
 from .reuse import ETA_MAX, ReusingSolver, forcing_term
+from .turning import TurningSearch, TurnState, turning_minimum
 
 __all__ = [
     "EXACT_TANGENT_BELOW",
@@ -94,6 +95,9 @@ class NewtonContext:
     #: The node a pattern free to turn (``orientation="free"``) turns about in a line search's
     #: steps (:class:`~vares.solver.line_search.StepPath`); ``None``: steps are straight lines.
     turning_about: int | None = None
+    #: The rotation about ``turning_about`` is an explicit unknown of the Newton system, with
+    #: its exact coupling (:mod:`vares.solver.turning`), instead of a step's least-squares turn.
+    turning: bool = False
     #: Give up a line-search iteration whose least residual has not halved over this many
     #: iterations (``None``: never), so the next attempt goes on from there: an energy with
     #: kinks can keep Newton's steps circling the solution (cells switching state at every
@@ -208,6 +212,8 @@ def newton(
     step_lengths: list[float] = []
     evaluation = None  # the line search's evaluation of the point it accepted, if it has one
     squeezed = 0  # iterations in a row whose steps a fold held back, each shorter
+    turn = TurnState()  # what turning steps carry over (``ctx.turning``)
+    floor_from = 0  # the residuals that show the round-off floor start here
     for iteration in range(ctx.max_iterations + 1):
         if evaluation is None:
             try:
@@ -220,11 +226,17 @@ def newton(
         residuals.append(residual / ctx.force_scale)
         step_lengths.append(step_length)
         converged = residual <= ctx.residual_tolerance or at_round_off(
-            residuals, step_lengths, ctx.round_off_regime
+            residuals[floor_from:], step_lengths[floor_from:], ctx.round_off_regime
         )
+        if converged and ctx.turning:  # a stationary rotation, or a minimum?
+            exact = ctx.assembler.matrix(evaluation.hessians)
+            converged = turning_minimum(x, ctx, exact, residual_vector)
+            if not converged:  # the residuals so far say nothing of the round-off floor
+                floor_from = len(residuals)
         # far from the solution (by the residual) the projected tangent, near it the exact one
         projected = (
             method == "line-search"
+            and not ctx.turning  # the exact tangent first, whatever the residual
             and not converged
             and residual >= EXACT_TANGENT_BELOW * ctx.force_scale
         )
@@ -250,9 +262,12 @@ def newton(
             )
             evaluation = None
         else:
-            search = LineSearch(
-                problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
-            )
+            if ctx.turning:
+                search = TurningSearch(problem, x, ctx, evaluation, matrix, residual_vector, turn)
+            else:
+                search = LineSearch(
+                    problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
+                )
             # the search owns the tangent now: it lets go of it before evaluating a trial point
             del evaluation, matrix, hessians
             x, step_length, tangent, evaluation = search.step()

@@ -33,7 +33,10 @@ from ..geometry.flatten import ProjectionPlane
 from ..mechanics.problem import Problem
 from .newton import Failure, NewtonContext, newton
 
-__all__ = ["Attempt", "follow_plan", "plan", "pseudo_time"]
+__all__ = ["FREE_ROTATION", "Attempt", "follow_plan", "plan", "pseudo_time", "turn_free"]
+
+#: The name of the step that lets a pattern solved with its rotation held turn freely.
+FREE_ROTATION = "free rotation"
 
 #: Pseudo-time steps are not cut back below this length.
 MIN_STEP = 1.0 / 1024
@@ -160,3 +163,32 @@ def pseudo_time(
             continue
         tau = planned.pop(0)
     return x
+
+
+def turn_free(
+    problem: Problem, coordinates: np.ndarray, ctx: NewtonContext, damping: float
+) -> tuple[np.ndarray, list[str], str | None]:
+    """From a pattern solved with its rotation held, the pattern free to turn (``ctx`` holds
+    only its translation and names the held node in ``turning_about``): globalised Newton with
+    the rotation as an explicit unknown (:mod:`vares.solver.turning`); should that fail,
+    globalised Newton whose steps turn by their least-squares turn, then damping, from where
+    it stopped. ``(pattern, names tried, reason of the last failure or None)``."""
+    ctx.turning = True
+    try:
+        x = ctx.attempt(
+            FREE_ROTATION,
+            1,
+            1.0,
+            lambda: newton(problem, coordinates, ctx, strategy=FREE_ROTATION, step=1, tau=1.0),
+        )
+        return x, [FREE_ROTATION], None
+    except Failure as failure:
+        resume = failure.coordinates
+    finally:
+        ctx.turning = False
+    attempts = [
+        Attempt("globalised newton", None, "line-search"),
+        Attempt("damping", None, "damped"),
+    ]
+    x, path, reason = follow_plan(problem, resume, None, attempts, ctx, damping)
+    return x, [FREE_ROTATION, *path], reason
