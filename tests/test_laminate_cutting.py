@@ -310,6 +310,8 @@ def test_job_writes_cutter_files_and_nest(job_run):
     blank = summary["blanks"][0]
     assert blank["net_mass"] == pytest.approx(200.0 * blank["net_area"] * 1e-6, rel=1e-12)
     assert blank["producibility"]["ok_fraction"] == 1.0
+    markdown = (out / "laminate.md").read_text()
+    assert "## The plies as cut" in markdown and f"yield {100 * nest['yield']:.1f} %" in markdown
 
 
 def test_ply_book_opens_in_chromium_with_a_section_per_ply(job_run, tmp_path):

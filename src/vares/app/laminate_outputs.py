@@ -49,6 +49,7 @@ from .staging import OutputFolder
 
 __all__ = [
     "LaminateRun",
+    "cutting_markdown",
     "file_label",
     "laminate_cutting",
     "laminate_files",
@@ -265,6 +266,36 @@ def laminate_markdown(result: LaminateResult) -> str:
     return "\n".join(lines)
 
 
+def cutting_markdown(run: LaminateRun) -> str:
+    """The plies as cut and the nest, as Markdown."""
+    units = run.units
+    allowance = run.result.laminate.options.trim_allowance
+    lines = [
+        "",
+        "## The plies as cut",
+        "",
+        f"| ply | orientation | net area [{units}²] | blank area (trim +{allowance:g}) "
+        f"[{units}²] | mass of the net [g] |",
+        "|---|---|---|---|---|",
+    ]
+    for blank in run.blanks:
+        mass = blank.mass(blank.net_area, units)
+        lines.append(
+            f"| {blank.name} | {blank.orientation:+g}° | {blank.net_area:.6g} | "
+            f"{blank.trim_area:.6g} | {'–' if mass is None else f'{mass:.4g}'} |"
+        )
+    nest = run.nest
+    if nest is not None:
+        lines += [
+            "",
+            f"Nested on a roll {nest.roll_width:g} {units} wide: {nest.length:.6g} {units} long, "
+            f"yield {100 * nest.yield_:.1f} %.",
+        ]
+    elif run.nest_error is not None:
+        lines += ["", f"Not nested: {run.nest_error}"]
+    return "\n".join([*lines, ""])
+
+
 def write_laminate(folder: OutputFolder, job: LaminateJob, run: LaminateRun) -> None:
     """Write every file of :func:`laminate_files` into the staged folder."""
     result = run.result
@@ -273,7 +304,7 @@ def write_laminate(folder: OutputFolder, job: LaminateJob, run: LaminateRun) -> 
         folder.staged(path).parent.mkdir(parents=True, exist_ok=True)
     staged = {p.name: folder.staged(p) for p in paths if p.parent == job.directory}
     write_json(staged["laminate.json"], run.summary())
-    write_text(staged["laminate.md"], laminate_markdown(result))
+    write_text(staged["laminate.md"], laminate_markdown(result) + cutting_markdown(run))
     write_surface(staged["laminate.vtu"], result.mesh, None, _cell_vectors(result))
     tables = orientation_tables(result)
     write_abaqus_orientations(staged["orientations.inp"], tables)
