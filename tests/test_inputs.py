@@ -476,3 +476,72 @@ def test_an_obj_face_index_out_of_range_is_named_as_written(tmp_path, face, mess
     path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\n" + face + "\n")
     with pytest.raises(MeshError, match=message):
         read_mesh_file(path)
+
+
+def _unwelded_panels_3dm(path, units="m"):
+    """Two hypar panels in a Rhino file, each stored with a vertex per face along x = 0 (as
+    Rhino often keeps seams), so that only welding makes each one piece."""
+    import rhino3dm
+
+    model = rhino3dm.File3dm()
+    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters
+    for name, shift in (("left", -5.0), ("right", 5.0)):
+        mesh = hypar(size=4.0, rise=0.05, n=4)
+        points, cells = [tuple(p) for p in mesh.points], mesh.cells["triangle"].copy()
+        right = mesh.points[cells].mean(axis=1)[:, 0] > 0
+        copies = {}
+        for row in np.flatnonzero(right):
+            for k, node in enumerate(cells[row]):
+                if abs(mesh.points[node, 0]) < 1e-12:
+                    copies.setdefault(node, len(points) + len(copies))
+                    cells[row, k] = copies[node]
+        points += [tuple(mesh.points[node]) for node in copies]
+        rhino_mesh = rhino3dm.Mesh()
+        for x, y, z in points:
+            rhino_mesh.Vertices.Add(float(x) + shift, float(y), float(z))
+        for a, b, c in cells:
+            rhino_mesh.Faces.AddFace(int(a), int(b), int(c))
+        attributes = rhino3dm.ObjectAttributes()
+        attributes.Name = name
+        model.Objects.AddMesh(rhino_mesh, attributes)
+    model.Write(str(path), 7)
+    return path
+
+
+def _structure_job(tmp_path, repair_meshes: bool):
+    from vares.app.job import load_job
+
+    job_file = tmp_path / f"job-{repair_meshes}.toml"
+    job_file.write_text(
+        f'[input]\nmeshes = ["panels.3dm"]\nrepair = {str(repair_meshes).lower()}\n'
+        '[material]\nfabric = "pes-pvc-type-2"\n[structure]\n[output]\ndirectory = "out"\n'
+    )
+    return load_job(job_file)
+
+
+def test_a_rhino_structure_is_read_with_one_parse_and_repaired_as_asked(tmp_path, monkeypatch):
+    import rhino3dm
+
+    from vares.app.inputs import load_input
+
+    _unwelded_panels_3dm(tmp_path / "panels.3dm")
+    parses = []
+    read = rhino3dm.File3dm.Read
+
+    def counted(path):
+        parses.append(path)
+        return read(path)
+
+    monkeypatch.setattr(rhino3dm.File3dm, "Read", counted)
+    loaded = load_input(_structure_job(tmp_path, repair_meshes=True))
+    assert len(parses) == 1  # meshes and units from the same parse
+    assert [p.name for p in loaded.panels] == ["left", "right"]
+    assert loaded.units == "m"
+    assert all(p.mesh.num_points == 25 for p in loaded.panels)  # 5 welded nodes each
+    assert sorted(loaded.repairs) == ["panels.3dm, object 'left'", "panels.3dm, object 'right'"]
+    assert all(r["welded_nodes"] == 5 for r in loaded.repairs.values())
+    assert any("repaired panels.3dm, object 'left'" in w for w in loaded.warnings)
+    # --no-repair (repair = false): taken as stored, each panel is two pieces along its seam
+    with pytest.raises(MeshError, match=r"panels.3dm: object 'left': .*2 separate pieces"):
+        load_input(_structure_job(tmp_path, repair_meshes=False))
+    assert len(parses) == 2

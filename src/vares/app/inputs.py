@@ -15,7 +15,7 @@ from ..geometry.examples import CUT_EXAMPLES, EXAMPLES, PANEL_NAMES, STRUCTURE_E
 from ..geometry.mesh import MeshError, SurfaceMesh
 from ..geometry.repair import RepairReport
 from ..io.meshes import MeshFile, read_mesh, read_mesh_data, read_mesh_file, read_pattern
-from ..io.rhino import read_3dm, unit_system
+from ..io.rhino import read_3dm_file
 from ..materials import Fibres
 from ..structures.panels import Panel, split_panels
 from ..units import implausible_size
@@ -128,10 +128,10 @@ def _example(job: Job) -> Input:
 def _structure(job: Job) -> Input:
     paths = [job.path(p) for p in job.input.paths]
     if len(paths) == 1 and paths[0].suffix.lower() == ".3dm":
-        meshes = read_3dm(paths[0], repair_meshes=job.input.repair)
-        panels = [Panel(m.name, m.mesh) for m in meshes]
-        loaded = Input(panels, _units(job, [unit_system(paths[0])]))
-        for m in meshes:
+        rhino = read_3dm_file(paths[0], repair_meshes=job.input.repair)  # one parse
+        panels = [Panel(m.name, m.mesh) for m in rhino.meshes]
+        loaded = Input(panels, _units(job, [rhino.units]))
+        for m in rhino.meshes:
             _note_repair(loaded, f"{paths[0].name}, object {m.name!r}", m.repair)
     elif len(paths) > 1:
         files = [_read(job, p) for p in paths]

@@ -27,13 +27,21 @@ import os
 import shutil
 import socket
 import tempfile
+import time
 from collections.abc import Iterable
 from pathlib import Path
 
 from .._version import __version__
 from ..io.files import OutputExistsError, current_umask, write_text
 
-__all__ = ["MANIFEST", "OutputFolder", "add_to_manifest", "listed"]
+__all__ = [
+    "ABANDONED_AFTER_HOURS",
+    "MANIFEST",
+    "OutputFolder",
+    "add_to_manifest",
+    "listed",
+    "process_start",
+]
 
 #: The file in an output folder that lists what the run wrote.
 MANIFEST = ".vares-run.json"
@@ -207,19 +215,63 @@ class OutputFolder:
 
 
 def _owned_folder(prefix: str, parent: Path) -> Path:
-    """A new hidden folder in ``parent`` that names this process (:data:`OWNER`)."""
+    """A new hidden folder in ``parent`` that names this process (:data:`OWNER`): its id, its
+    machine and, where the system tells, when it started (a process id is reused)."""
     folder = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
     owner = {"pid": os.getpid(), "host": socket.gethostname()}
+    started = process_start(os.getpid())
+    if started is not None:
+        owner["started"] = started
     (folder / OWNER).write_text(json.dumps(owner), encoding="utf-8")
     return folder
 
 
+#: A staging folder whose process cannot be asked whether it still runs (another machine's,
+#: or one that did not say when it started while its id is in use) is taken for abandoned
+#: after this many hours.
+ABANDONED_AFTER_HOURS = 48.0
+
+
+def process_start(pid: int) -> str | None:
+    """When process ``pid`` started, as a token that differs between two processes of the same
+    id (Linux: the boot and the start time in clock ticks), or ``None`` where the system does
+    not tell or the process does not exist."""
+    try:
+        boot = Path("/proc/sys/kernel/random/boot_id").read_text(encoding="ascii").strip()
+        stat = Path(f"/proc/{pid}/stat").read_text(encoding="ascii")
+    except (OSError, UnicodeDecodeError):
+        return None
+    fields = stat[stat.rfind(")") + 2 :].split()  # after the command name, which may hold ")"
+    return f"{boot}:{fields[19]}" if len(fields) > 19 else None
+
+
+def _abandoned(folder: Path, owner: dict, host: str) -> bool:
+    """Whether the run that wrote ``folder`` (its :data:`OWNER` record ``owner``) has ended."""
+    pid = int(owner["pid"])
+    if owner["host"] == host:
+        if pid == os.getpid() and owner.get("started") in (None, process_start(pid)):
+            return False  # this very process
+        if not _alive(pid):
+            return True
+        started, now = owner.get("started"), process_start(pid)
+        if started is not None and now is not None:
+            return started != now  # the id belongs to another process now
+    try:  # its process cannot be asked: by its age
+        age = time.time() - (folder / OWNER).stat().st_mtime
+    except OSError:
+        return False
+    return age > ABANDONED_AFTER_HOURS * 3600.0
+
+
 def _remove_abandoned(directory: Path) -> None:
     """Clean up after runs into ``directory`` (and into folders inside it, as ``erect/``) whose
-    process, on this machine, has ended (killed: an interrupted run cleans up itself): remove
-    their staging folders, and put back a previous run they had moved aside and not replaced
-    (else remove it). POSIX only: elsewhere a process cannot be asked whether it lives without
-    a handle to it."""
+    process has ended (killed: an interrupted run cleans up itself): remove their staging
+    folders, and put back a previous run they had moved aside and not replaced (else remove
+    it). A run has ended when its process, on this machine, is gone or its id now names a
+    process that started at another time; a run of another machine's process, or one whose
+    start is not known while its id is in use, when it is older than
+    :data:`ABANDONED_AFTER_HOURS`. POSIX only: elsewhere a process cannot be asked whether it
+    lives without a handle to it."""
     if os.name != "posix":
         return
     host = socket.gethostname()
@@ -232,11 +284,10 @@ def _remove_abandoned(directory: Path) -> None:
     for folder in [*staged, *aside]:
         try:
             owner = json.loads((folder / OWNER).read_text(encoding="utf-8"))
-            pid, same_host = int(owner["pid"]), owner["host"] == host
-        except (OSError, ValueError, KeyError, TypeError):
+            if not _abandoned(folder, owner, host):
+                continue
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
             continue  # no owner named: a finished run kept beside the folder, or not ours
-        if not same_host or pid == os.getpid() or _alive(pid):
-            continue
         target = folder.parent / folder.name[1:].rsplit(".old-", 1)[0]
         if folder in aside and (folder / "run").is_dir() and not target.exists():
             os.replace(folder / "run", target)  # killed between the two renames of the swap

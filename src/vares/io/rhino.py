@@ -17,7 +17,16 @@ from ..geometry.mesh import MeshError, SurfaceMesh
 from ..geometry.repair import RepairReport, repair
 from ..geometry.weld import coincident_nodes
 
-__all__ = ["NamedMesh", "RawMesh", "read_3dm", "read_3dm_raw", "unit_system", "write_3dm"]
+__all__ = [
+    "NamedMesh",
+    "RawMesh",
+    "RhinoFile",
+    "read_3dm",
+    "read_3dm_file",
+    "read_3dm_raw",
+    "unit_system",
+    "write_3dm",
+]
 
 #: Rhino unit systems and vares' names for them.
 _UNITS = {
@@ -84,16 +93,17 @@ def _weld(parts: list[tuple[np.ndarray, dict[str, np.ndarray]]]):
     return points[first], {t: np.vstack(b) for t, b in cells.items()}
 
 
-def read_3dm_raw(path: str | Path) -> list[RawMesh]:
-    """Every object's mesh of a Rhino file as stored, named (see the module docs).
+@dataclass(frozen=True)
+class RhinoFile:
+    """What a Rhino file holds for vares, read with one parse: its objects' meshes (repaired
+    unless asked not to) and its declared length unit (``None`` when it declares none)."""
 
-    Raises
-    ------
-    FileNotFoundError
-        No such file.
-    MeshError
-        Not a readable 3dm file, or no usable mesh in it.
-    """
+    meshes: list[NamedMesh]
+    units: str | None
+
+
+def _model(path: str | Path):
+    """The parsed Rhino model of ``path`` (a one-line :class:`MeshError` if it is none)."""
     import rhino3dm
 
     path = Path(path)
@@ -102,6 +112,12 @@ def read_3dm_raw(path: str | Path) -> list[RawMesh]:
     model = rhino3dm.File3dm.Read(str(path))
     if model is None:
         raise MeshError(f"cannot read {path}: not a Rhino 3dm file, or a damaged one")
+    return model
+
+
+def _raw_meshes(model, path: Path) -> list[RawMesh]:
+    import rhino3dm
+
     layers = {i: model.Layers[i].FullPath for i in range(len(model.Layers))}
     out, skipped = [], []
     for index, obj in enumerate(model.Objects):
@@ -134,37 +150,7 @@ def read_3dm_raw(path: str | Path) -> list[RawMesh]:
     return out
 
 
-def read_3dm(path: str | Path, *, repair_meshes: bool = True) -> list[NamedMesh]:
-    """All meshes of a Rhino file, named (see the module docs), each repaired as a mesh file
-    is (:func:`vares.geometry.repair.repair`: Rhino meshes often keep a vertex per face at
-    creases and seams, which would cut the surface apart), unless ``repair_meshes`` is false.
-
-    Raises
-    ------
-    FileNotFoundError
-        No such file.
-    MeshError
-        Not a readable 3dm file, no usable mesh in it, or an invalid mesh (naming the object).
-    """
-    out = []
-    for raw in read_3dm_raw(path):
-        try:
-            fixed = repair(raw.points, raw.cells, weld=repair_meshes)
-            mesh = SurfaceMesh(fixed.points, fixed.cells)
-        except MeshError as exc:
-            raise MeshError(f"{path}: object {raw.name!r}: {exc}") from exc
-        out.append(NamedMesh(raw.name, raw.layer, mesh, fixed.report))
-    return out
-
-
-def unit_system(path: str | Path) -> str | None:
-    """The length unit a Rhino file declares (``"mm"``, ``"m"`` …), ``None`` when it declares
-    none; a unit vares does not know is a :class:`MeshError`."""
-    import rhino3dm
-
-    model = rhino3dm.File3dm.Read(str(path))
-    if model is None:
-        raise MeshError(f"cannot read {path}: not a Rhino 3dm file, or a damaged one")
+def _units(model, path: Path) -> str | None:
     system = model.Settings.ModelUnitSystem.name
     if system in ("None", "Unset"):
         return None
@@ -174,6 +160,72 @@ def unit_system(path: str | Path) -> str | None:
             f"{', '.join(_UNITS)}: change the model's units in Rhino"
         )
     return _UNITS[system]
+
+
+def read_3dm_raw(path: str | Path) -> list[RawMesh]:
+    """Every object's mesh of a Rhino file as stored, named (see the module docs).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    MeshError
+        Not a readable 3dm file, or no usable mesh in it.
+    """
+    return _raw_meshes(_model(path), Path(path))
+
+
+def read_3dm_file(path: str | Path, *, repair_meshes: bool = True) -> RhinoFile:
+    """All meshes of a Rhino file, named (see the module docs), and its length unit, from one
+    parse of the file. Each mesh is repaired as a mesh file is
+    (:func:`vares.geometry.repair.repair`: Rhino meshes often keep a vertex per face at
+    creases and seams, which would cut the surface apart) unless ``repair_meshes`` is false;
+    then it is taken as stored (only polygons triangulated, unused nodes dropped).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    MeshError
+        Not a readable 3dm file, no usable mesh in it, a unit vares does not know, or an
+        invalid mesh (naming the object).
+    """
+    path = Path(path)
+    model = _model(path)
+    units = _units(model, path)
+    out = []
+    for raw in _raw_meshes(model, path):
+        try:
+            fixed = repair(raw.points, raw.cells, weld=repair_meshes)
+            if not fixed.cells:
+                raise MeshError(
+                    "every one of its cells is collapsed (no area) or a duplicate: nothing is "
+                    "left to pattern"
+                )
+            mesh = SurfaceMesh(fixed.points, fixed.cells)
+        except MeshError as exc:
+            raise MeshError(f"{path}: object {raw.name!r}: {exc}") from exc
+        out.append(NamedMesh(raw.name, raw.layer, mesh, fixed.report))
+    return RhinoFile(out, units)
+
+
+def read_3dm(path: str | Path, *, repair_meshes: bool = True) -> list[NamedMesh]:
+    """All meshes of a Rhino file, named and repaired (:func:`read_3dm_file`).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    MeshError
+        Not a readable 3dm file, no usable mesh in it, or an invalid mesh (naming the object).
+    """
+    return read_3dm_file(path, repair_meshes=repair_meshes).meshes
+
+
+def unit_system(path: str | Path) -> str | None:
+    """The length unit a Rhino file declares (``"mm"``, ``"m"`` …), ``None`` when it declares
+    none; a unit vares does not know is a :class:`MeshError`."""
+    return _units(_model(path), Path(path))
 
 
 def write_3dm(path: str | Path, meshes: list[NamedMesh], units: str | None = None) -> None:
