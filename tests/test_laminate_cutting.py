@@ -368,3 +368,39 @@ def test_ply_book_without_weights_or_roll_says_so(laminate, blanks):
     assert "<p id='total-thickness'>Total thickness: –.</p>" in page
     assert page.count("<section class='ply'") == 4
     assert page.count("data:image/png;base64,") == 3 * 4
+
+
+def test_a_ply_with_a_hole_has_a_net_and_trim_ring_for_it(tmp_path):
+    mesh = mould()
+    centroids = mesh.points[mesh.cells["triangle"]].mean(axis=1)
+    frame = (np.abs(centroids[:, :2]).max(axis=1) > 2.5).astype(float)  # a square hole
+    plies = [Ply(PlyOptions(name="frame", orientation=30.0, region="frame"), NCF)]
+    result = drape_laminate(
+        mesh, plies, cell_data={"frame": frame}, workers=1, kinematic=False, trim_allowance=0.4
+    )
+    assert result.converged
+    (blank,) = ply_blanks(result)
+    drape = result.drape("frame")
+    x = drape.pattern.material_coordinates
+    assert len(blank.net) == len(blank.trim) == 2
+    outer, hole = Polygon(blank.net[0]), Polygon(blank.net[1])
+    assert outer.exterior.is_ccw and not Polygon(blank.net[1]).exterior.is_ccw
+    cells = x[drape.mesh.cells["triangle"]]
+    e1, e2 = cells[:, 1] - cells[:, 0], cells[:, 2] - cells[:, 0]
+    area = 0.5 * np.sum(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    assert blank.net_area == pytest.approx(outer.area - hole.area, rel=1e-12)
+    assert blank.net_area == pytest.approx(area, rel=1e-12)
+    # the hole's trim line lies inside the hole, the allowance away from its edge
+    trim_hole = Polygon(blank.trim[1])
+    assert hole.contains(trim_hole)
+    assert hole.exterior.distance(trim_hole.exterior) == pytest.approx(0.4, abs=1e-9)
+    write_ply_dxf(tmp_path / "frame.dxf", blank, units="m")
+    found = entities(tmp_path / "frame.dxf")
+    assert len(found["NET", "LWPOLYLINE"]) == 2 and len(found["TRIM", "LWPOLYLINE"]) == 2
+    loops = {len(loop): x[loop] for loop in drape.mesh.boundary_loops()}
+    for drawn in found["NET", "LWPOLYLINE"]:
+        ring = points(drawn)
+        expected = loops[len(ring)]
+        if Polygon(expected).exterior.is_ccw != Polygon(ring).exterior.is_ccw:
+            expected = expected[::-1]
+        np.testing.assert_allclose(ring, expected, rtol=0, atol=1e-9)
