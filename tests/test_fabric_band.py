@@ -17,6 +17,7 @@ from vares.geometry.examples import STRUCTURE_EXAMPLES
 from vares.materials import MaterialError
 from vares.materials.biaxial_model import ECRModel, compensation_protocol, simulate
 from vares.materials.compensation_law import strains_per_cycle
+from vares.materials.fabric_file import ConstantScatter, constant_scatter
 from vares.materials.presets import file_fabric
 from vares.structures.matching import solve_structure
 from vares.structures.panels import split_panels
@@ -75,8 +76,9 @@ def test_seam_band_holds_the_nominal_and_grows_with_the_scatter(strips, batch):
     # the samples are the fabric's: the same seed draws the same values, scaled about the mean
     c = batch.compensation
     drawn = np.asarray(compensation_samples(batch, 6, 3))
-    assert np.allclose(np.asarray(one.cases), drawn, rtol=0, atol=1e-15)
-    assert np.allclose(np.asarray(two.cases) - [c.warp, c.fill], 2 * (drawn - [c.warp, c.fill]))
+    cases = [np.array([[s["warp"], s["fill"]] for s in b.cases]) for b in (one, two)]
+    assert np.array_equal(cases[0], drawn)
+    assert np.allclose(cases[1] - [c.warp, c.fill], 2 * (drawn - [c.warp, c.fill]))
 
 
 def test_erected_prestress_of_the_nominal_case_is_the_plain_erection(strips, batch):
@@ -89,7 +91,7 @@ def test_erected_prestress_of_the_nominal_case_is_the_plain_erection(strips, bat
         assert band.band.nominal[name] == pytest.approx(value, rel=1e-12), name
     # a sample compensated more (a softer fabric at the prestress) is erected with less warp
     # prestress from the nominal patterns
-    warp = np.asarray(band.cases)[:, 0]
+    warp = np.array([s["warp"] for s in band.cases])
     stress = np.asarray(band.band.samples["prestress warp_mean"])
     order = np.argsort(warp)
     assert stress[order[0]] > stress[order[-1]]
@@ -97,7 +99,47 @@ def test_erected_prestress_of_the_nominal_case_is_the_plain_erection(strips, bat
 
 def test_a_band_needs_measured_compensation_values(strips, batch):
     with pytest.raises(MaterialError, match="no measured compensation values"):
-        fabric_band(strips, replace(batch, compensation=None), **SETTINGS)
+        fabric_band(strips, replace(batch, compensation=None), prestress=(2.0, 1.5), **SETTINGS)
+    with pytest.raises(MaterialError, match="no scatter of its constants given"):
+        fabric_band(strips, batch, scatter=ScatterOptions(sampled="constants"), **SETTINGS)
+
+
+def test_band_of_the_fitted_constants(strips, batch):
+    """Sampling E1, E2, nu12: the nominal case is the fitted law's pattern and its plain
+    erection; zero scatter gives zero spread exactly; the file's scatter gives a band."""
+    scatter = constant_scatter(SHIPPED / "pes-batch-42.toml")
+    assert (scatter.E1, scatter.E2, scatter.specimens) == pytest.approx(
+        (14.9603, 15.4456, 2), rel=1e-5
+    )
+    options = ScatterOptions(sampled="constants", samples=3, seed=2)
+    zero = fabric_band(
+        strips, batch, constants=ConstantScatter(0.0, 0.0, 0.0), scatter=options, **SETTINGS
+    )
+    assert all(zero.band.spread(n) == 0.0 for n in zero.band.names)
+    law = batch.material("law")
+    structure = solve_structure(strips, law, prestress=(2.0, 1.5), **SETTINGS)
+    plain = prestress_figures(vares.erect(structure))
+    for name, value in plain.items():
+        assert zero.band.nominal[name] == pytest.approx(value, rel=1e-12), name
+    band = fabric_band(strips, batch, constants=scatter, scatter=options, **SETTINGS)
+    assert band.band.nominal == zero.band.nominal
+    assert all(band.band.spread(n) > 0 for n in band.band.names)
+    assert [set(s) for s in band.cases] == [{"E1", "E2", "nu12"}] * 3
+    assert band.to_dict()["constants_std"]["E1"] == scatter.E1
+
+
+def test_constant_scatter_errors(tmp_path):
+    path = tmp_path / "f.toml"
+    path.write_text('[f]\nE1 = 1\n[f.scatter]\nE1 = "x"\n', encoding="utf-8")
+    with pytest.raises(MaterialError, match=r"\[f.scatter\]: E1, E2 and nu12 must be numbers"):
+        constant_scatter(path)
+    path.write_text("[f]\nE1 = 1\n[f.scatter]\nE1 = -1.0\n", encoding="utf-8")
+    with pytest.raises(MaterialError, match="must be numbers ≥ 0"):
+        constant_scatter(path)
+    with pytest.raises(MaterialError, match="has no fabric"):
+        constant_scatter(path, "g")
+    path.write_text("[f]\nE1 = 1\n", encoding="utf-8")
+    assert constant_scatter(path) is None
 
 
 def test_strains_per_cycle():

@@ -9,10 +9,12 @@ pattern compensated by their mean is one of the patterns the batch allows.
   pattern and the smallest and largest over the corners, and how far any node moves (after the
   best rigid fit).
 - :func:`compensation_samples` draws random compensation values from their scatter (independent
-  normal warp and fill values: a batch of a few specimens says nothing of their correlation) and
-  :class:`Band` gathers any named figures of the samples (:class:`ScatterOptions`: how many
-  samples, which seed, how many standard deviations the band spans). The solves themselves are
-  :func:`vares.app.fabric_band.fabric_band`'s, which also erects the patterns.
+  normal warp and fill values: a batch of a few specimens says nothing of their correlation),
+  :func:`constant_samples` the fitted constants ``E1, E2, nu12`` from theirs, and
+  :class:`Band` gathers any named figures of the samples (:class:`ScatterOptions`: what is
+  sampled, how many samples, which seed, how many standard deviations the band spans). The
+  solves themselves are :func:`vares.app.fabric_band.fabric_band`'s, which also erects the
+  patterns.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from ..geometry.mesh import SurfaceMesh
 from ..materials.anisotropic import OrthotropicStVenantKirchhoff
 from ..materials.base import MaterialError
 from ..materials.compensation_law import compensating_law
+from ..materials.fabric_file import ConstantScatter
 from ..materials.presets import FabricPreset
 from ..options import Options, option
 from ..solver.api import solve
@@ -37,6 +40,8 @@ __all__ = [
     "ScatterOptions",
     "check_scatter",
     "compensation_samples",
+    "constant_samples",
+    "constants_law",
     "pattern_band",
     "pattern_dimensions",
     "sample_law",
@@ -90,12 +95,24 @@ def pattern_dimensions(result: PatternResult) -> dict[str, float]:
     }
 
 
+#: What a band samples.
+SAMPLED = ("compensation", "constants")
+
+
 @dataclass(frozen=True)
 class ScatterOptions(Options):
     """How the scatter of a fabric's compensation values is sampled and reported."""
 
     title = "scatter option"
 
+    sampled: str = option(
+        "compensation",
+        "str",
+        "What is sampled: the measured compensation values (the pattern compensated by them) "
+        "or the fitted constants E1, E2, nu12 (the pattern compensated by the fitted law).",
+        section="scatter",
+        choices=SAMPLED,
+    )
     samples: int = option(
         16,
         "int",
@@ -137,6 +154,35 @@ def compensation_samples(
             f"strain (warp {c.warp:.3g} ± {c.warp_std:.3g}, fill {c.fill:.3g} ± {c.fill_std:.3g})"
         )
     return [(float(w), float(f)) for w, f in drawn]
+
+
+def constant_samples(
+    fabric: FabricPreset, scatter: ConstantScatter, samples: int, seed: int = 0
+) -> list[tuple[float, float, float]]:
+    """``samples`` (E1, E2, nu12) drawn from independent normal distributions with the fabric's
+    constants as means and ``scatter``'s standard deviations. Raises :class:`MaterialError`
+    when a draw is not an admissible orthotropic law."""
+    z = np.random.default_rng(seed).standard_normal((int(samples), 3))
+    mean = np.array([fabric.E1, fabric.E2, fabric.nu12])
+    drawn = mean + z * [scatter.E1, scatter.E2, scatter.nu12]
+    out = [(float(a), float(b), float(c)) for a, b, c in drawn]
+    for values in out:
+        constants_law(fabric, *values)
+    return out
+
+
+def constants_law(
+    fabric: FabricPreset, E1: float, E2: float, nu12: float
+) -> OrthotropicStVenantKirchhoff:
+    """The fabric's orthotropic law with the constants ``E1``, ``E2`` (kN/m), ``nu12`` and its
+    own ``G12``; :class:`MaterialError` names the fabric when they are not admissible."""
+    try:
+        return OrthotropicStVenantKirchhoff(E1, E2, fabric.G12, nu12)
+    except (MaterialError, ValueError) as exc:
+        raise MaterialError(
+            f"fabric {fabric.name!r}: a sample of its constants (E1 {E1:.4g}, E2 {E2:.4g}, "
+            f"nu12 {nu12:.4g}) is not a law: {exc}"
+        ) from None
 
 
 def sample_law(fabric: FabricPreset, warp: float, fill: float) -> OrthotropicStVenantKirchhoff:

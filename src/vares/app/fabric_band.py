@@ -1,9 +1,11 @@
-"""The band of a structure's patterns under the scatter of its fabric's compensation values.
+"""The band of a structure's patterns under the scatter of its fabric.
 
 :func:`fabric_band` patterns the panels (seams matched, as ``vares panels`` does) compensated by
 the fabric's mean measured values — the nominal case — and again for each of
 ``ScatterOptions.samples`` random draws of the values (:func:`vares.analysis.scatter.
-compensation_samples`). Each case gives the length along the warp, the width along the fill, the
+compensation_samples`); or, with ``ScatterOptions.sampled = "constants"``, with the fitted law
+of the mean constants and of random draws of ``E1, E2, nu12`` (:func:`vares.analysis.scatter.
+constant_samples`). Each case gives the length along the warp, the width along the fill, the
 boundary length and the area of every panel's pattern, the length of every seam, and the
 **erected prestress**: the nominal patterns — the ones that are cut — erected
 (:func:`vares.erect`) with the fabric of the sample. That is the structure the client gets when
@@ -31,10 +33,13 @@ from ..analysis.scatter import (
     Band,
     ScatterOptions,
     compensation_samples,
+    constant_samples,
+    constants_law,
     pattern_dimensions,
     sample_law,
 )
 from ..materials.base import MaterialError
+from ..materials.fabric_file import ConstantScatter
 from ..materials.presets import FabricPreset
 from ..parallel import process_pool
 from ..structures.matching import StructureResult, solve_structure
@@ -149,41 +154,57 @@ class FabricBand:
     """A structure's patterns under the scatter of its fabric (module docs).
 
     ``band``: every figure's nominal value and samples (:class:`Band`); ``cases``: the sampled
-    (warp, fill) compensation values; ``nominal``: the nominal structure and ``erection`` its
-    plain erection (None when not erected); ``seconds``: the nominal case's time and the
-    samples' total wall time.
+    values (``warp``, ``fill`` compensation strains, or ``E1``, ``E2``, ``nu12``); ``constants``:
+    the constants' scatter they were drawn with (None for compensation values); ``nominal``: the
+    nominal structure and ``erection`` its plain erection (None when not erected); ``seconds``:
+    the nominal case's time and the samples' total wall time.
     """
 
     fabric: FabricPreset
     prestress: tuple[float, float]
     options: ScatterOptions
     band: Band
-    cases: list[tuple[float, float]]
+    cases: list[dict[str, float]]
     nominal: StructureResult
     erection: ErectionResult | None
     seconds: dict[str, float] = field(default_factory=dict)
+    constants: ConstantScatter | None = None
+
+    @property
+    def sampled(self) -> str:
+        """What was sampled, in words."""
+        if self.options.sampled == "constants":
+            return "the fitted constants E1, E2, nu12 (independent normal), compensated by the law"
+        return "the compensation values (independent normal warp and fill)"
 
     def to_dict(self) -> dict[str, object]:
         """The band as ``summary.json`` keeps it."""
-        c = self.fabric.compensation
-        return {
-            "fabric": self.fabric.name,
-            "source": self.fabric.source,
-            "compensation": {
+        f, c, s = self.fabric, self.fabric.compensation, self.constants
+        out: dict[str, object] = {
+            "fabric": f.name,
+            "source": f.source,
+            "constants": {"E1": f.E1, "E2": f.E2, "G12": f.G12, "nu12": f.nu12},
+        }
+        if s is not None:
+            out["constants_std"] = {"E1": s.E1, "E2": s.E2, "nu12": s.nu12}
+        if c is not None:
+            out["compensation"] = {
                 "prestress": list(c.prestress),
                 "warp": c.warp,
                 "fill": c.fill,
                 "warp_std": c.warp_std,
                 "fill_std": c.fill_std,
                 "specimens": c.specimens,
-            },
+            }
+        return {
+            **out,
             "prestress": list(self.prestress),
             "scatter": self.options.to_dict(),
-            "sampled": "compensation values (independent normal warp and fill)",
+            "sampled": self.sampled,
             "erected": "the nominal patterns erected with the fabric of each sample",
             "panels": [p.name for p in self.nominal.panels],
             "figures": self.band.to_dict(),
-            "samples": [{"warp": w, "fill": f} for w, f in self.cases],
+            "samples": self.cases,
             "seconds": self.seconds,
             "converged": True,
         }
@@ -196,6 +217,7 @@ def fabric_band(
     prestress: tuple[float, float] | None = None,
     *,
     scatter: ScatterOptions | None = None,
+    constants: ConstantScatter | None = None,
     erection: ErectionOptions | None = None,
     erected: bool = True,
     workers: int | None = None,
@@ -204,20 +226,34 @@ def fabric_band(
 ) -> FabricBand:
     """The nominal case and ``scatter.samples`` sampled cases of ``panels`` (module docs).
 
-    ``prestress`` defaults to the one the values were measured at; ``settings`` are options of
-    :func:`vares.solve_structure` (``warp_direction``, ``match_seams``, …); ``erected`` False
-    leaves out the erections. Raises :class:`MaterialError` for a fabric without measured
-    compensation values and when a case does not converge.
+    ``prestress`` defaults to the one the values were measured at; ``constants``: the scatter
+    of the constants (:func:`vares.materials.fabric_file.constant_scatter`), needed when they
+    are sampled; ``settings`` are options of :func:`vares.solve_structure` (``warp_direction``,
+    ``match_seams``, …); ``erected`` False leaves out the erections. Raises
+    :class:`MaterialError` for a fabric without what is to be sampled and when a case does not
+    converge.
     """
     scatter = scatter or ScatterOptions()
     c = fabric.compensation
-    if c is None:
-        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+    if prestress is None and c is None:
+        raise MaterialError(f"fabric {fabric.name!r} has no measured prestress: give one")
     load = tuple(float(v) for v in (c.prestress if prestress is None else prestress))
-    cases = compensation_samples(fabric, scatter.samples, scatter.seed)
+    if scatter.sampled == "constants":
+        if constants is None:
+            raise MaterialError(f"fabric {fabric.name!r}: no scatter of its constants given")
+        law = constants_law(fabric, fabric.E1, fabric.E2, fabric.nu12)
+        drawn = constant_samples(fabric, constants, scatter.samples, scatter.seed)
+        cases = [{"E1": a, "E2": b, "nu12": n} for a, b, n in drawn]
+        laws = [constants_law(fabric, *values) for values in drawn]
+    else:
+        if c is None:
+            raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+        law = sample_law(fabric, c.warp, c.fill)
+        drawn = compensation_samples(fabric, scatter.samples, scatter.seed)
+        cases = [{"warp": w, "fill": f} for w, f in drawn]
+        laws = [sample_law(fabric, w, f) for w, f in drawn]
     panels = tuple(panels)
     started = time.perf_counter()
-    law = sample_law(fabric, c.warp, c.fill)
     nominal = solve_structure(list(panels), law, thickness, prestress=load, **settings)
     if not nominal.converged:
         raise MaterialError(f"the nominal patterns did not converge: {nominal.reason}")
@@ -231,18 +267,17 @@ def fabric_band(
         figures.update(prestress_figures(plain))
     nominal_seconds = time.perf_counter() - started
     tasks = [
-        SampleTask(panels, sample_law(fabric, w, f), thickness, load, settings, patterns, erection)
-        for w, f in cases
+        SampleTask(panels, sample, thickness, load, settings, patterns, erection) for sample in laws
     ]
     started = time.perf_counter()
     outcomes = map_samples(solve_sample, tasks, workers=workers, scheduler=scheduler)
     failed = [(k, o.reason) for k, o in enumerate(outcomes) if not o.converged]
     if failed:
         k, reason = failed[0]
-        w, f = cases[k]
+        values = ", ".join(f"{name} {value:.4g}" for name, value in cases[k].items())
         raise MaterialError(
-            f"{len(failed)} of {len(cases)} samples did not converge; the first (warp "
-            f"{100 * w:.3f} %, fill {100 * f:.3f} %): {reason}"
+            f"{len(failed)} of {len(cases)} samples did not converge; the first ({values}): "
+            f"{reason}"
         )
     return FabricBand(
         fabric,
@@ -257,4 +292,5 @@ def fabric_band(
             "samples": time.perf_counter() - started,
             "per_sample_mean": float(np.mean([o.seconds for o in outcomes])),
         },
+        constants,
     )

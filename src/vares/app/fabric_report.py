@@ -144,19 +144,29 @@ def fit_report(fitted: FabricFit, records: list[BiaxialRecord]) -> str:
 
 def band_report(band: FabricBand, units: str = "m") -> str:
     """The band's report (one HTML page, the figure embedded)."""
-    c = band.fabric.compensation
     scatter = band.options
     parts = page(band.fabric.name, f"Pattern band: {band.fabric.name}", "converged", [])
     parts.append("<h2>Fabric and samples</h2>")
+    parts.append(f"<p>{html.escape(band.fabric.name)} ({html.escape(band.fabric.source)}): ")
+    c, s = band.fabric.compensation, band.constants
+    if scatter.sampled == "constants" and s is not None:
+        f = band.fabric
+        parts.append(
+            f"fitted constants E1 {f.E1:.1f} ± {s.E1:.1f}, E2 {f.E2:.1f} ± {s.E2:.1f} kN/m, "
+            f"nu12 {f.nu12:.3f} ± {s.nu12:.3f} ({s.specimens or '?'} specimens); G12 "
+            f"{f.G12:g} kN/m. "
+        )
+    elif c is not None:
+        parts.append(
+            f"compensation values at {c.prestress[0]:g}/{c.prestress[1]:g} kN/m warp "
+            f"{100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, fill {100 * c.fill:.3f} ± "
+            f"{100 * c.fill_std:.3f} % ({c.specimens or '?'} specimens). "
+        )
     parts.append(
-        f"<p>{html.escape(band.fabric.name)}: compensation values at "
-        f"{c.prestress[0]:g}/{c.prestress[1]:g} kN/m warp {100 * c.warp:.3f} ± "
-        f"{100 * c.warp_std:.3f} %, fill {100 * c.fill:.3f} ± {100 * c.fill_std:.3f} % "
-        f"({c.specimens or '?'} specimens; {html.escape(band.fabric.source)}). "
-        f"{scatter.samples} samples (seed {scatter.seed}) of independent normal warp and fill "
-        f"values; the band is the nominal value ± {scatter.sigmas:g} sample standard "
-        "deviations. Prestress: the nominal patterns erected with the fabric of each sample "
-        f"(prestress {band.prestress[0]:g}/{band.prestress[1]:g}).</p>"
+        f"{scatter.samples} samples (seed {scatter.seed}) of {html.escape(band.sampled)}; the "
+        f"band is the nominal value ± {scatter.sigmas:g} sample standard deviations. "
+        "Prestress: the nominal patterns erected with the fabric of each sample (prestress "
+        f"{band.prestress[0]:g}/{band.prestress[1]:g}).</p>"
     )
     rows = [
         (

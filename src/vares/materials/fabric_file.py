@@ -30,15 +30,18 @@ numbers were found. ``vares fabric fit`` writes one; it is usable wherever a pre
     …
 
 Only ``E1, E2, G12, nu12, source`` and the compensation table's ``prestress``, ``warp`` and
-``fill`` are read into the preset; the rest documents the fit.
+``fill`` are read into the preset; :func:`constant_scatter` reads the scatter table (for the
+band of the constants, :mod:`vares.app.fabric_band`); the rest documents the fit.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
+import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -50,7 +53,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "COMPENSATE_BY",
+    "ConstantScatter",
     "MeasuredCompensation",
+    "constant_scatter",
     "fabric_toml",
     "fit_toml",
     "read_test_tables",
@@ -76,6 +81,51 @@ class MeasuredCompensation:
     warp_std: float = 0.0
     fill_std: float = 0.0
     specimens: int | None = None
+
+
+@dataclass(frozen=True)
+class ConstantScatter:
+    """The sample standard deviations of a fabric's fitted constants over its specimens:
+    ``E1``, ``E2`` (kN/m) and ``nu12``, and the number of specimens (None if not given)."""
+
+    E1: float
+    E2: float
+    nu12: float
+    specimens: int | None = None
+
+
+def constant_scatter(path: str | Path, name: str | None = None) -> ConstantScatter | None:
+    """The ``[NAME.scatter]`` table of a fabric file (``name``: the fabric, default the file's
+    only one); None when the entry has none. Raises :class:`MaterialError` for a file that is
+    not valid TOML, an unknown name, or values that are not non-negative numbers."""
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise MaterialError(f"{path}: not valid TOML: {exc}") from exc
+    if name is None:
+        if len(data) != 1:
+            raise MaterialError(f"{path} holds {len(data)} fabrics: name one")
+        name = next(iter(data))
+    if name not in data or not isinstance(data[name], dict):
+        raise MaterialError(f"{path} has no fabric [{name}]")
+    table = data[name].get("scatter")
+    if table is None:
+        return None
+    where = f"{path}: [{name}.scatter]"
+    if not isinstance(table, dict):
+        raise MaterialError(f"{where} must be a table")
+    try:
+        values = [float(table.get(k, 0.0)) for k in ("E1", "E2", "nu12")]
+    except (TypeError, ValueError):
+        raise MaterialError(f"{where}: E1, E2 and nu12 must be numbers") from None
+    if not all(math.isfinite(v) and v >= 0 for v in values):
+        raise MaterialError(f"{where}: E1, E2 and nu12 must be numbers ≥ 0")
+    specimens = table.get("specimens")
+    if specimens is not None and (
+        isinstance(specimens, bool) or not isinstance(specimens, int) or specimens < 1
+    ):
+        raise MaterialError(f"{where}: specimens must be a positive integer")
+    return ConstantScatter(values[0], values[1], values[2], specimens)
 
 
 def read_test_tables(

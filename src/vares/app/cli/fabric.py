@@ -257,7 +257,7 @@ def _scatter_flags() -> list[inspect.Parameter]:
         option_parameter(
             name,
             defaults[name],
-            {"int": int, "float": float}[spec.kind],
+            {"int": int, "float": float, "str": str}[spec.kind],
             flag_name(name, spec),
             help=f"{spec.help} ({spec.bounds()})",
             panel="Scatter",
@@ -324,9 +324,10 @@ def band(
     **values: Any,
 ) -> None:
     """The band of a panel's or a structure's patterns under the scatter of its fabric's
-    compensation values: the patterns solved for random samples of the values, and the
-    pattern dimensions, seam lengths and the erected prestress (the nominal patterns erected
-    with each sample's fabric) as nominal ± SIGMAS standard deviations (docs/fabrics.md)."""
+    compensation values (or, with --sampled constants, of its fitted constants): the patterns
+    solved for random samples of the values, and the pattern dimensions, seam lengths and the
+    erected prestress (the nominal patterns erected with each sample's fabric) as nominal ±
+    SIGMAS standard deviations (docs/fabrics.md)."""
 
     def body() -> None:
         import json
@@ -336,6 +337,8 @@ def band(
         from ...analysis.scatter import ScatterOptions, check_scatter
         from ...geometry.examples import STRUCTURE_EXAMPLES
         from ...io.files import check_writable, write_text
+        from ...materials.base import MaterialError
+        from ...materials.fabric_file import constant_scatter
         from ...materials.presets import file_fabric
         from ...options import OptionsError
         from ...structures.options import StructureOptions
@@ -363,12 +366,31 @@ def band(
             source, several = {"meshes": tuple(str(f.resolve()) for f in files)}, True
         structure = StructureOptions(match_seams=match) if several else None
         loaded = load_input(Job(input=InputOptions(**source), structure=structure))
+        for warning in loaded.warnings:
+            console.print(f"warning: {warning}")
         settings: dict[str, Any] = {"match_seams": match}
         if warp_direction is not None:
             settings["warp_direction"] = _vector(warp_direction, "--warp-direction")
         preset = file_fabric(fabric_file)
-        check_scatter(preset)
-        c = preset.compensation
+        constants = None
+        if scatter.sampled == "constants":
+            constants = constant_scatter(fabric_file, preset.name)
+            if constants is None or constants.E1 == constants.E2 == constants.nu12 == 0:
+                raise MaterialError(
+                    f"fabric {preset.name!r} has no scatter of its constants (no [scatter] "
+                    "table, or its E1, E2, nu12 are 0): fit two or more stiffness records"
+                )
+            title = (
+                f"{preset.name}: E1 {preset.E1:.1f} ± {constants.E1:.1f}, E2 {preset.E2:.1f} ± "
+                f"{constants.E2:.1f} kN/m, nu12 {preset.nu12:.3f} ± {constants.nu12:.3f}"
+            )
+        else:
+            check_scatter(preset)
+            c = preset.compensation
+            title = (
+                f"{preset.name}: warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, fill "
+                f"{100 * c.fill:.3f} ± {100 * c.fill_std:.3f} %"
+            )
         targets = [] if output is None else [output / "summary.json", output / "report.html"]
         check_writable(targets, force)
         result = fabric_band(
@@ -376,6 +398,7 @@ def band(
             preset,
             prestress=_pair(prestress, "--prestress"),
             scatter=scatter,
+            constants=constants,
             erected=erect,
             workers=workers,
             scheduler=scheduler,
@@ -386,9 +409,8 @@ def band(
             "nominal",
             f"± {scatter.sigmas:g} std",
             "samples min … max",
-            title=f"{preset.name}: warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, fill "
-            f"{100 * c.fill:.3f} ± {100 * c.fill_std:.3f} %, {scatter.samples} samples "
-            f"({loaded.units}; prestress: the nominal patterns erected with each sample's fabric)",
+            title=f"{title}, {scatter.samples} samples ({loaded.units}; prestress: the nominal "
+            "patterns erected with each sample's fabric)",
         )
         for name, d in result.band.to_dict().items():
             table.add_row(
