@@ -47,9 +47,7 @@ def coincident_nodes(
     index = np.arange(n) if candidates is None else np.asarray(candidates, dtype=np.int64)
     if tolerance <= 0 or index.size < 2:
         return np.arange(n)
-    from scipy.spatial import cKDTree  # scipy.spatial: 0.1–0.25 s to import, used here only
-
-    pairs = index[cKDTree(points[index]).query_pairs(tolerance, output_type="ndarray")]
+    pairs = index[_close_pairs(points[index], tolerance)]
     if apart is not None:
         pairs = pairs[apart[pairs[:, 0]] != apart[pairs[:, 1]]]
     if not len(pairs):
@@ -59,6 +57,27 @@ def coincident_nodes(
     first = np.full(label.max() + 1, n)
     np.minimum.at(first, label, np.arange(n))
     return first[label]
+
+
+#: Up to this many nodes, close pairs are found by comparing every pair (a few milliseconds);
+#: more go through a k-d tree (scipy.spatial, 0.1–0.25 s to import).
+_PAIRWISE_NODES = 3000
+
+
+def _close_pairs(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """The pairs ``(i, j)``, ``i < j``, of points at most ``tolerance`` apart, ``(k, 2)``."""
+    if len(points) > _PAIRWISE_NODES:
+        from scipy.spatial import cKDTree
+
+        return cKDTree(points).query_pairs(tolerance, output_type="ndarray")
+    found = []
+    for start in range(0, len(points), 500):  # rows of at most 500 × n distances at a time
+        block = points[start : start + 500]
+        distance = np.linalg.norm(block[:, None, :] - points[None, :, :], axis=2)
+        i, j = np.nonzero(distance <= tolerance)
+        i += start
+        found.append(np.column_stack([i, j])[i < j])
+    return np.concatenate(found).astype(np.int64) if found else np.empty((0, 2), np.int64)
 
 
 def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welded:
