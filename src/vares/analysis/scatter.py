@@ -116,7 +116,7 @@ class ScatterOptions(Options):
     samples: int = option(
         16,
         "int",
-        "Random samples of the compensation values, each solved (and erected) on its own.",
+        "Random samples of what is sampled, each solved (and erected) on its own.",
         section="scatter",
         minimum=1,
     )

@@ -272,7 +272,9 @@ def band(
     fabric_file: Annotated[
         Path,
         typer.Option(
-            "--fabric", help="A fabric file with measured compensation values and their scatter."
+            "--fabric",
+            help="A fabric file with measured compensation values and their scatter (with "
+            "--sampled constants: with the scatter of its constants).",
         ),
     ],
     inputs: Annotated[
