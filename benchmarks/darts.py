@@ -70,14 +70,14 @@ def main() -> None:
                     f"total {total:.1f} s"
                 )
                 for r in s["rounds"]:
-                    lengths = ", ".join(f"{v:.1f}" for v in r["lengths"])
+                    lengths = ", ".join(f"{v:.4g}" for v in r["lengths"])
                     print(
                         f"  tip {r['tip_angle']:.1f}°: darts {lengths}; largest shear "
                         f"{r['max_shear']:.2f}°, {r['iterations']} it, {r['seconds']:.1f} s, "
                         f"converged {r['converged']}"
                     )
                 if darted.after is not None:
-                    openings = ", ".join(f"{v:.1f}" for v in s["mouth_openings"])
+                    openings = ", ".join(f"{v:.4g}" for v in s["mouth_openings"])
                     print(
                         f"  after: {s['darts']} darts, largest shear {s['max_shear_after']:.2f}°, "
                         f"relieved {s['relieved']}, mouth openings {openings}"

@@ -258,6 +258,11 @@ def test_drape_command_with_dart_lines(tmp_path):
     ]:
         refused = run(*base[:-1], tmp_path / "refused", "--dart-lines", curves, *extra)
         assert refused.exit_code == 2 and message in error_line(refused), refused.stderr
+    far = tmp_path / "far.txt"
+    far.write_text("0 0 300\n0 10 300\n")
+    refused = run(*base[:-1], tmp_path / "refused", "--dart-lines", far, *ncf)
+    assert refused.exit_code == 2 and "from the mould" in error_line(refused)
+    assert not (tmp_path / "refused").exists()
     refused = run(*base[:-1], tmp_path / "refused", *ncf)
     assert refused.exit_code == 2 and "add --darts auto" in error_line(refused)
     refused = run(*base[:-1], tmp_path / "refused", "--darts", "auto", "--material", "neo-hooke")

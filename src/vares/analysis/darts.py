@@ -246,9 +246,10 @@ class DartedPattern:
     """A pattern before and after its darts were opened.
 
     ``before``: the pattern of the mesh without darts; ``after``: of ``slits.mesh`` with the
-    last round's darts open (None when no dart was needed or placed); ``slits``: the opened
-    mesh, its lips and the dart lines ``(k, 3)`` on the mould; ``rounds``: every solve with
-    darts; ``locking_angle`` in degrees.
+    darts of the round ``chosen`` open (None when no dart was needed or placed): the first
+    round below the locking angle, else the converged one with the least largest shear;
+    ``slits``: the opened mesh, its lips and the dart lines ``(k, 3)`` on the mould; ``rounds``:
+    every solve with darts; ``locking_angle`` in degrees.
     """
 
     before: PatternResult
@@ -256,6 +257,7 @@ class DartedPattern:
     slits: SlitMesh | None
     locking_angle: float
     rounds: list[DartRound] = field(default_factory=list)
+    chosen: int = -1
 
     @property
     def dart_lines(self) -> list[np.ndarray]:
@@ -268,7 +270,7 @@ class DartedPattern:
 
     @property
     def max_shear_after(self) -> float | None:
-        return None if not self.rounds else self.rounds[-1].max_shear
+        return None if self.after is None else self.rounds[self.chosen].max_shear
 
     @property
     def relieved(self) -> bool:
@@ -300,6 +302,7 @@ class DartedPattern:
             "iterations_before": self.before.iterations,
             "seconds_before": self.before.elapsed,
             "rounds": [vars(r) for r in self.rounds],
+            "chosen_round": None if self.after is None else self.chosen % len(self.rounds),
         }
 
 
@@ -331,6 +334,7 @@ def solve_with_darts(
     if options.dart_lines is not None and polylines is None:
         raise ValueError("dart_lines names a file: pass its lines as polylines (read_curves)")
     mesh = triangulated(mesh)
+    given = None if polylines is None else darts_from_polylines(mesh, polylines)  # refused early
     before = solve(mesh, material, thickness, **solve_settings)
     result = DartedPattern(before, None, None, locking_angle)
     if not before.converged or (polylines is None and options.darts == "none"):
@@ -339,8 +343,8 @@ def solve_with_darts(
     warp, fill = erected_yarns(mesh, before.material_coordinates, fibres.warp, fibres.fill)
     shear = before.fields["shear_angle"]
     plans: list[tuple[float | None, list[SurfaceLine] | None]]
-    if polylines is not None:
-        plans = [(None, darts_from_polylines(mesh, polylines))]
+    if given is not None:
+        plans = [(None, given)]
     else:
         if not np.nanmax(np.abs(shear)) >= locking_angle:
             return result
@@ -348,7 +352,7 @@ def solve_with_darts(
         plans = [(max(f, 0.0) * locking_angle, None) for f in fractions]
     locator = FaceLocator(mesh)
     done: list[DartRound] = []
-    slits = after = None
+    best: tuple[float, PatternResult, SlitMesh, int] | None = None
     for tip, lines in plans:
         if lines is None:
             lines = place_darts(
@@ -356,17 +360,25 @@ def solve_with_darts(
             )
         if not lines:
             break
+        lengths = [line.length for line in lines]
+        previous = done[-1].lengths if done else []
+        if len(previous) == len(lengths) and np.allclose(lengths, previous):
+            break  # no longer than the last round's: nothing new to solve
         slits = open_slits(mesh, lines)
         start = _carried(locator, mesh, before.material_coordinates, slits.mesh.points)
         clock = time.perf_counter()
         after = solve(slits.mesh, material, thickness, **{**solve_settings, "initial_guess": start})
         seconds = time.perf_counter() - clock
         largest = float(np.nanmax(np.abs(after.fields["shear_angle"])))
-        lengths = [line.length for line in lines]
         done.append(DartRound(tip, lengths, largest, after.iterations, seconds, after.converged))
+        rank = largest if after.converged else np.inf
+        if best is None or rank < best[0]:
+            best = (rank, after, slits, len(done) - 1)
         if after.converged and largest < locking_angle:
             break
-    return DartedPattern(before, after, slits, locking_angle, done)
+    if best is None:
+        return DartedPattern(before, None, None, locking_angle, done)
+    return DartedPattern(before, best[1], best[2], locking_angle, done, best[3])
 
 
 def _carried(
