@@ -5,7 +5,8 @@ The summary: every ply's orientation, thickness, areas, mass, largest shear and 
 stacking sequence with its thicknesses, the nest on the roll and the pair matrices of the
 ply-stack check. Each ply's section: its flat blank with the net and extended boundaries and the
 rosette (the 0° arrow along the warp, the 90° arrow along the fill, at the seed), its shear and
-producibility maps, its numbers, and its darts.
+producibility maps, its numbers, and its darts (none yet: a laminate's plies are not darted;
+the section says how much of the ply is at or beyond the locking angle).
 
 Producibility here is that of the blank as cut: the mechanical drape's shear angle against the
 locking angle of the ply's fabric kind (warning from :class:`~vares.analysis.drape_options.
@@ -255,7 +256,8 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
     ident = html.escape(blank.name)
     limit = 100 * check.fractions["limit"]
     darts = (
-        f"<p id='darts-{ident}'>No darts: vares does not cut darts yet. "
+        f"<p id='darts-{ident}'>No darts: a laminate's plies are not darted yet (vares drape "
+        "--darts darts a single ply). "
         f"{limit:.1f} % of the ply's area is at or beyond the locking angle"
         + (" (a dart or another seed or orientation is needed there)." if limit > 0 else ".")
         + "</p>"
