@@ -267,3 +267,41 @@ def test_drape_command_with_dart_lines(tmp_path):
     assert refused.exit_code == 2 and "add --darts auto" in error_line(refused)
     refused = run(*base[:-1], tmp_path / "refused", "--darts", "auto", "--material", "neo-hooke")
     assert refused.exit_code == 2 and "yarns" in error_line(refused)
+
+
+def test_darts_move_with_the_mould():
+    """A rigid motion of the mould, its seed and its warp moves the darts with it: the same
+    lengths, the mouths moved (the kinematic net's shear and yarns as the field)."""
+    from conftest import rotation
+
+    from vares.geometry.drape import kinematic_drape
+
+    mesh = irregular_cap(R, 90.0, 20, 0.3, 1)
+    turn, shift = rotation(3), np.array([10.0, -20.0, 5.0])
+    moved = SurfaceMesh(mesh.points @ turn.T + shift, mesh.cells)
+    found = []
+    for surface, seed, warp in [
+        (mesh, np.array([0, 0, R]), np.array([1.0, 0, 0])),
+        (moved, turn @ [0, 0, R] + shift, turn @ [1.0, 0, 0]),
+    ]:
+        drape = kinematic_drape(surface, seed, warp, 2.0)
+        found.append(place_darts(surface, drape.shear_angle, drape.warp, drape.fill, 48.0, 40.0))
+    assert len(found[0]) == len(found[1]) == 4
+    lengths = [sorted(line.length for line in lines) for lines in found]
+    assert np.allclose(lengths[0], lengths[1], rtol=1e-6)
+    mouths = np.array([line.points[0] for line in found[0]]) @ turn.T + shift
+    for line in found[1]:
+        assert np.linalg.norm(mouths - line.points[0], axis=1).min() < 1e-6 * R
+
+
+def test_no_dart_where_none_is_needed():
+    from vares.materials import NonCrimpFabric
+
+    cap = irregular_cap(R, 45.0, 10, 0.3, 1)
+    law = NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5])
+    darted = solve_with_darts(cap, law, locking_angle=LOCKING, darts="auto")
+    assert darted.before.converged and darted.max_shear_before < LOCKING
+    assert darted.after is None and darted.rounds == [] and darted.relieved
+    assert darted.summary()["darts"] == 0
+    with pytest.raises(ValueError, match="dart_lines names a file"):
+        solve_with_darts(cap, law, locking_angle=LOCKING, dart_lines="darts.txt")
