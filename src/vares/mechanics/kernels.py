@@ -33,6 +33,7 @@ __all__ = [
     "block_energy",
     "determinant",
     "inverse",
+    "nodal_hessian",
     "project_psd",
     "projected_hessian",
 ]
@@ -114,7 +115,7 @@ def block_energy(
     if order < 2:
         return BlockResult(energy, gradient, None)
     shape_gradients = np.ascontiguousarray(element.shape_gradients, dtype=dtype)
-    hessian = _nodal_hessian(jacobian_hessian, shape_gradients, scale)
+    hessian = nodal_hessian(jacobian_hessian, shape_gradients, scale)
     return BlockResult(energy, gradient, hessian, jacobian_hessian)
 
 
@@ -127,7 +128,7 @@ def projected_hessian(
     projected = jacobian_hessian.copy()
     project_psd(projected)
     scale = thickness * element.quadrature_weights
-    return _nodal_hessian(projected, np.ascontiguousarray(element.shape_gradients), scale)
+    return nodal_hessian(projected, np.ascontiguousarray(element.shape_gradients), scale)
 
 
 @njit(cache=True)
@@ -257,7 +258,7 @@ def _derivatives(
 
 
 @njit(cache=True)
-def _nodal_hessian(jacobian_hessian, shape_gradients, scale):  # pragma: no cover
+def nodal_hessian(jacobian_hessian, shape_gradients, scale):  # pragma: no cover
     """``Σ_q w_q Bᵀ H_q B``: nodal Hessian ``(m, nen, 2, nen, 2)`` from ``(m, q, 4, 4)``."""
     m, nq = jacobian_hessian.shape[0], jacobian_hessian.shape[1]
     nen = shape_gradients.shape[1]

@@ -46,7 +46,7 @@ from ..geometry.elements import ELEMENTS
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic, MaterialError
 from .assembly import Connectivity
-from .kernels import _nodal_hessian, block_energy, projected_hessian
+from .kernels import block_energy, nodal_hessian, projected_hessian
 
 __all__ = ["PATCH_BLOCK", "YARN_STRAINS", "ShearPart", "YarnSmoothing", "paired_domains"]
 
@@ -327,7 +327,7 @@ class YarnSmoothing:
                 total = np.ascontiguousarray(total)
                 dtype = total.dtype
                 hessians.append(
-                    _nodal_hessian(
+                    nodal_hessian(
                         total,
                         np.ascontiguousarray(element.shape_gradients, dtype=dtype),
                         (self.thickness * element.quadrature_weights).astype(dtype),
