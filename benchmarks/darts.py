@@ -14,6 +14,11 @@ Moulds: ``hemisphere`` (``irregular_cap(100, 90, rings, 0.3, 1)``, R = 100 mm to
 
     python benchmarks/darts.py --rings 20 30 40 --control --picture docs/images
     python benchmarks/darts.py --mould rib30 --locking 50 4
+    python benchmarks/darts.py --rings 30 --turned 0 15 30 45 --length 35
+
+(``--turned``: on the hemisphere, four given darts of ``--length`` mm from the equator at the
+45° meridians, each a great circle turned by these angles from the meridian, the same way round
+at every dart, instead of the automatic ones.)
 """
 
 from __future__ import annotations
@@ -51,7 +56,13 @@ def main() -> None:
     parser.add_argument("--locking", type=float, nargs="+", default=[50.0])
     parser.add_argument("--control", action="store_true", help="solve the darts cut but closed")
     parser.add_argument("--picture", type=Path, help="folder for darts_<mould>.png")
+    parser.add_argument("--turned", type=float, nargs="+", help="given darts turned (degrees)")
+    parser.add_argument("--length", type=float, default=35.0, help="their length (mm)")
     args = parser.parse_args()
+    if args.turned:
+        for rings in args.rings:
+            turned(rings, args.law[0], args.locking[0], args.turned, args.length)
+        return
     rings_list = args.rings if args.mould == "hemisphere" else [0]
     for rings in rings_list:
         mesh, warp = mould(args.mould, rings)
@@ -111,6 +122,34 @@ def main() -> None:
                     figure.savefig(path)
                     plt.close(figure)
                     print(f"  wrote {path}")
+
+
+def turned(rings: int, law: str, locking: float, angles: list[float], length: float) -> None:
+    """Given darts on the hemisphere, turned from the meridians (module docs)."""
+    mesh, warp = mould("hemisphere", rings)
+    for angle in angles:
+        lines = []
+        for azimuth in np.radians([45.0, 135.0, 225.0, 315.0]):
+            mouth = np.array([np.cos(azimuth), np.sin(azimuth), 0.0])
+            along = np.array([-np.sin(azimuth), np.cos(azimuth), 0.0])
+            a = np.radians(angle)
+            heading = np.cos(a) * np.array([0.0, 0.0, 1.0]) + np.sin(a) * along
+            s = np.linspace(0.0, length / 100.0, 12)[:, None]
+            lines.append(100.0 * (np.cos(s) * mouth + np.sin(s) * heading))
+        clock = time.perf_counter()
+        darted = solve_with_darts(
+            mesh, LAWS[law](), locking_angle=locking, polylines=lines, warp_direction=warp
+        )
+        s = darted.summary()
+        r = s["rounds"][0]
+        openings = ", ".join(f"{v:.4g}" for v in s["mouth_openings"])
+        lengths = ", ".join(f"{v:.4g}" for v in s["dart_lengths"])
+        print(
+            f"hemisphere {rings} ({mesh.num_cells} cells), {law}, darts turned {angle:g}° from "
+            f"the meridian: before {s['max_shear_before']:.2f}°, after {r['max_shear']:.2f}° "
+            f"({r['iterations']} it, converged {r['converged']}); lengths {lengths}; mouths "
+            f"{openings}; {time.perf_counter() - clock:.1f} s"
+        )
 
 
 if __name__ == "__main__":
