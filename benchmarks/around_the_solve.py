@@ -1,7 +1,8 @@
 """What a `vares pattern` command costs around its solve: reading, checking, files, previews
 and the report, for a small roof, a 20k-triangle scan and a 100k-triangle hypar.
 
-    python benchmarks/around_the_solve.py [--repeat 5] [--sizes small scan large]
+    python benchmarks/around_the_solve.py [--repeat 5] [--sizes sail small scan large]
+    python benchmarks/around_the_solve.py --breakdown [--repeat 5] [--sizes sail]
 
 Every run is a fresh `vares pattern FILE -o DIR --force` process (compiled kernels cached on
 disk, as after the first run of an install), in three variants: `--no-previews`, the default
@@ -12,12 +13,25 @@ imports them and calls one compiled (cached) numba function, the floor under any
 The command is the ``vares`` script installed beside this Python (a version manager's shim on
 PATH, such as pyenv's, adds its own start-up: 0.08 s here), else the one on PATH; it imports
 the package from PYTHONPATH first: ``PYTHONPATH=src`` measures this tree's code.
+
+Python's compiled byte code is written and used as on any install (``PYTHONDONTWRITEBYTECODE``
+removed from the commands' environment, the byte code kept in a folder of the benchmark's own,
+``PYTHONPYCACHEPREFIX``); with ``--no-bytecode`` every module is compiled from source at every
+start, as where that variable is set (some containers): compare the two.
+
+``--breakdown``: where the time of a default run goes, phase by phase, medians over fresh
+processes: starting Python, importing the command line, reading and checking the mesh, loading
+the solver's compiled kernels, the solve, each output file (the first file to need a library
+imports it: the DXF's time includes ezdxf's import), and the rest (the job file, moving the
+staging folder into place, exiting); then the libraries' import times (``-X importtime``,
+summed per top-level package).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -30,6 +44,7 @@ import meshio
 from vares import examples
 
 SIZES = {
+    "sail": ("four-point sail, 512 triangles (OBJ)", lambda: examples.four_point_sail(n=16)),
     "small": ("roof, 4,608 triangles (OBJ)", lambda: examples.hypar(n=48)),
     "scan": ("scan, 19,573 triangles (OBJ)", lambda: examples.scan_like(triangles=20000)),
     "large": ("hypar, 100,352 triangles (OBJ)", lambda: examples.hypar(n=224)),
@@ -42,10 +57,23 @@ def vares_script() -> str:
     return str(beside) if beside.is_file() else "vares"
 
 
+#: The environment of every command: byte code written and used (or not, ``--no-bytecode``).
+ENVIRONMENT = dict(os.environ)
+
+
+def set_bytecode(write: bool, folder: Path) -> None:
+    ENVIRONMENT.pop("PYTHONDONTWRITEBYTECODE", None)
+    ENVIRONMENT.pop("PYTHONPYCACHEPREFIX", None)
+    if write:
+        ENVIRONMENT["PYTHONPYCACHEPREFIX"] = str(folder / "bytecode")
+    else:
+        ENVIRONMENT["PYTHONDONTWRITEBYTECODE"] = "1"
+
+
 def run(path: Path, out: Path, flags: list[str]) -> tuple[float, float]:
     command = [vares_script(), "pattern", str(path), "-o", str(out), "--force", "-q", *flags]
     start = time.perf_counter()
-    subprocess.run(command, check=True, capture_output=True)
+    subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)
     wall = time.perf_counter() - start
     summary = json.loads((out / "summary.json").read_text())
     return wall, summary["elapsed_seconds"] + summary.get("warm_up_seconds", 0.0)
@@ -53,7 +81,7 @@ def run(path: Path, out: Path, flags: list[str]) -> tuple[float, float]:
 
 #: What a `vares pattern` run loads, without vares: the floor of its time.
 LIBRARIES = """\
-import numpy as np, scipy.sparse, scipy.sparse.csgraph, scipy.spatial, numba
+import numpy as np, scipy.sparse, scipy.sparse.csgraph, scipy.sparse.linalg, numba
 import ezdxf, typer, rich, meshio, shapely, PIL.Image
 
 @numba.njit(cache=True)
@@ -67,29 +95,157 @@ first(np.ones(3))
 def libraries_alone(folder: Path, repeat: int) -> float:
     script = folder / "libraries.py"
     script.write_text(LIBRARIES)
-    subprocess.run([sys.executable, str(script)], check=True)  # compiles once, cached after
+    subprocess.run([sys.executable, str(script)], check=True, env=ENVIRONMENT)  # compiles once
     times = []
     for _ in range(repeat):
         start = time.perf_counter()
-        subprocess.run([sys.executable, str(script)], check=True)
+        subprocess.run([sys.executable, str(script)], check=True, env=ENVIRONMENT)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
+
+
+#: A default `vares pattern` run in a fresh process with each phase timed (the command line's
+#: own functions wrapped, nothing else changed); prints the phases as JSON.
+BREAKDOWN = """\
+import json, os, sys, time
+started = time.perf_counter()
+from vares.app.cli import main
+imported = time.perf_counter()
+from vares.app import outputs, runner
+phases = {}
+
+def timed(name, function):
+    def call(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return function(*args, **kwargs)
+        finally:
+            phases[name] = phases.get(name, 0.0) + time.perf_counter() - start
+    return call
+
+runner.load_input = timed("read", runner.load_input)
+runner._solve = timed("solve", runner._solve)
+runner.write_job_file = timed("job.toml", runner.write_job_file)
+write = outputs._write
+outputs._write = lambda panel, name, writer: timed(name, write)(panel, name, writer)
+sys.argv = ["vares", "pattern", *sys.argv[1:]]
+end = os._exit
+os._exit = lambda code: None  # the command ends the process itself: print first, then end
+try:
+    main()
+except SystemExit:
+    pass
+phases["import"] = imported - started
+phases["command"] = time.perf_counter() - started
+print(json.dumps(phases), flush=True)
+end(0)
+"""
+
+
+def breakdown(path: Path, folder: Path, repeat: int) -> None:
+    """The phases of a default run, medians of ``repeat`` fresh processes."""
+    script = folder / "breakdown.py"
+    script.write_text(BREAKDOWN)
+    out = folder / "breakdown"
+    command = [sys.executable, str(script), str(path), "-o", str(out), "--force", "-q"]
+    subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)  # warm
+    python = [sys.executable, "-c", "pass"]
+    rows: list[dict[str, float]] = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        subprocess.run(python, check=True, env=ENVIRONMENT)
+        alone = time.perf_counter() - start
+        start = time.perf_counter()
+        done = subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)
+        whole = time.perf_counter() - start
+        phases = json.loads(done.stdout.decode().strip().splitlines()[-1])
+        summary = json.loads((out / "summary.json").read_text())
+        kernels = summary.get("warm_up_seconds", 0.0)
+        phases["loading the kernels"] = kernels
+        phases["solve"] -= kernels
+        phases["starting Python"] = alone
+        phases["whole process"] = whole
+        timed = [k for k in phases if k not in ("command", "whole process", "starting Python")]
+        phases["the rest"] = phases["command"] - sum(phases[k] for k in timed)
+        phases["exit"] = whole - alone - phases["command"]
+        rows.append(phases)
+    order = ["whole process", "starting Python", "import", "read", "loading the kernels", "solve"]
+    order += [k for k in rows[0] if k not in {*order, "command", "the rest", "exit"}]
+    order += ["the rest", "exit"]
+    names = {
+        "import": "importing the command line",
+        "read": "reading and checking the mesh",
+        "the rest": "the rest of the command (arguments, options, checks, staging folder)",
+        "exit": "ending the process, and what the clock saw outside the command",
+    }
+    print("| phase | s |")
+    print("|---|---|")
+    for key in order:
+        value = statistics.median(r[key] for r in rows)
+        print(f"| {names.get(key, key)} | {value:.3f} |")
+    importtime(command, repeat)
+
+
+def importtime(command: list[str], repeat: int) -> None:
+    """The import time of each top-level package in a run (``-X importtime``, self times
+    summed per package), medians."""
+    totals: list[dict[str, float]] = []
+    for _ in range(repeat):
+        done = subprocess.run(
+            [command[0], "-X", "importtime", *command[1:]],
+            check=True,
+            capture_output=True,
+            env=ENVIRONMENT,
+        )
+        sums: dict[str, float] = {}
+        for line in done.stderr.decode().splitlines():
+            if not line.startswith("import time:") or "self [us]" in line:
+                continue
+            own, _, name = line[len("import time:") :].split("|")
+            package = name.strip().split(".")[0]
+            sums[package] = sums.get(package, 0.0) + int(own) / 1e6
+        totals.append(sums)
+    packages = sorted(totals[0], key=lambda k: -totals[0][k])
+    print("| package imported | s |")
+    print("|---|---|")
+    everything = statistics.median(sum(t.values()) for t in totals)
+    for package in packages[:12]:
+        print(f"| {package} | {statistics.median(t.get(package, 0.0) for t in totals):.3f} |")
+    print(f"| all imports | {everything:.3f} |")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--sizes", nargs="+", default=list(SIZES), choices=list(SIZES))
+    parser.add_argument("--sizes", nargs="+", default=None, choices=list(SIZES))
+    parser.add_argument("--breakdown", action="store_true", help="phase by phase, one size")
+    parser.add_argument("--no-bytecode", action="store_true", help="compile every module anew")
     args = parser.parse_args()
+    sizes = args.sizes or (["sail"] if args.breakdown else list(SIZES))
+    flags = (" --breakdown" if args.breakdown else "") + (
+        " --no-bytecode" if args.no_bytecode else ""
+    )
     print(f"# python benchmarks/around_the_solve.py --repeat {args.repeat} --sizes "
-          f"{' '.join(args.sizes)}")  # fmt: skip
+          f"{' '.join(sizes)}{flags}")  # fmt: skip
+    if args.breakdown:
+        with tempfile.TemporaryDirectory() as folder:
+            folder = Path(folder)
+            set_bytecode(not args.no_bytecode, folder)
+            label, make = SIZES[sizes[0]]
+            mesh = make()
+            path = folder / f"{sizes[0]}.obj"
+            meshio.write(path, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+            print(f"{label}, default outputs")
+            breakdown(path, folder, args.repeat)
+        return
     print("| surface | variant | whole command s | solve s | rest s |")
     print("|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
+        set_bytecode(not args.no_bytecode, folder)
         floor = libraries_alone(folder, args.repeat)
         print(f"| (no surface) | the libraries alone | {floor:.2f} | | |")
-        for size in args.sizes:
+        for size in sizes:
             label, make = SIZES[size]
             mesh = make()
             path = folder / f"{size}.obj"
