@@ -227,8 +227,15 @@ def test_drape_command_with_dart_lines(tmp_path):
     data = json.loads((out / "drape.json").read_text())["darts"]
     assert data["darts"] == 4 and data["max_shear_after"] < data["max_shear_before"] - 4.0
     assert min(data["mouth_openings"]) > 10.0
-    layers = [e.dxf.layer for e in ezdxf.readfile(out / "pattern.dxf").modelspace()]
+    entities = list(ezdxf.readfile(out / "pattern.dxf").modelspace())
+    layers = [e.dxf.layer for e in entities]
     assert layers.count("DART") == 4 and layers.count("SEAM") == 1
+    (seam,) = [np.array(e.get_points("xy")) for e in entities if e.dxf.layer == "SEAM"]
+    for dart in (np.array(e.get_points("xy")) for e in entities if e.dxf.layer == "DART"):
+        # both lips are pieces of the pattern's outline, apart at the mouth, one at the tip
+        nearest = np.linalg.norm(dart[:, None, :] - seam[None, :, :], axis=2).min(axis=1)
+        assert nearest.max() < 1e-9
+        assert np.linalg.norm(dart[0] - dart[-1]) > 10.0
     opened = meshio.read(out / "darts.vtu")
     assert len(opened.points) > mesh.num_points
     assert (out / "darts.png").stat().st_size > 10_000
