@@ -1,17 +1,19 @@
 """Darts: cuts from a ply's boundary into the region whose shear exceeds the locking angle, and
 the pattern solved again with the darts open (DESIGN.md §8).
 
-**Where.** The cells at or beyond the locking angle form regions (neighbours across edges). A
-region that reaches the boundary gets one dart from the boundary side nearest the region's
-shear-weighted centre there (weights: the shear beyond the locking angle); a region inside the
-surface, from the boundary side nearest its most sheared cell.
+**Where.** The cells at or beyond the locking angle form regions (neighbours across edges),
+joined through the cells whose :func:`smoothed` shear is within :data:`JOIN_FRACTION` of it: the
+cell-to-cell scatter of linear triangles with stiff yarns does not split a region. A region that
+reaches the boundary gets one dart from the boundary side nearest the region's shear-weighted
+centre there (weights: the shear beyond the locking angle); a region inside the surface, from
+the boundary side nearest its most sheared cell.
 
 **Which way.** Sheared yarns at an angle ``θ < 90°`` lengthen the bisector of their acute angle
 (``2 cos(θ/2)``) and shorten the other diagonal (``2 sin(θ/2)``): the fabric is squeezed across
 the bisector. A cut along the bisector opens against that squeeze, and relieves the most shear.
 The dart follows the bisector of the erected yarns (``F Φ₁``, ``F Φ₂`` of the pattern) from cell
-to cell (:func:`vares.geometry.slits.walk_line`) until the shear falls below the dart's
-**tip angle**, or to ``max_length``. On a sphere, with the warp along a symmetry plane, the
+to cell (:func:`vares.geometry.slits.walk_line`) until the smoothed shear falls below the
+dart's **tip angle**, or to ``max_length``. On a sphere, with the warp along a symmetry plane, the
 bisector on the 45° meridians is the meridian itself.
 
 **How far.** :func:`solve_with_darts` solves the pattern, places the darts with the tip angle
