@@ -1,0 +1,96 @@
+"""Frictionless contact with a mould: nodes that slide on a surface and cannot leave it.
+
+Each sliding node ``a`` lies on a face of the mould (:class:`vares.geometry.mould.Mould`) and
+moves in that face's plane, ``x_a + T_a Δu_a`` with ``T_a`` ``(3, 2)`` an orthonormal basis of
+the plane, after which it is put back onto the mould at the nearest point (the retraction of
+Newton's method on a surface). The reaction of a frictionless contact is normal to the mould, so
+equilibrium is the vanishing of the tangential forces ``T_aᵀ g_a``; the reduced tangent is
+``Tᵀ K T``. Inside a face the mould is flat and the reduced problem is the exact one: Newton's
+method keeps its rate once every node stays in its face.
+
+A **held** node does not move (the seed). A **guided** node moves only along the line where its
+face's plane meets a given plane (the warp's plane through the seed): it keeps the blank from
+turning about the seed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..geometry.mould import Mould
+
+__all__ = ["SlidingNodes", "turned_over"]
+
+
+@dataclass
+class SlidingNodes:
+    """The nodes of a blank on a mould: ``positions`` ``(n, 3)`` on it, the ``faces`` ``(n,)``
+    they lie in, the ``held`` nodes ``(n,)`` bool, and ``guided``: node → unit normal ``(3,)`` of
+    the plane the node stays in."""
+
+    mould: Mould
+    positions: np.ndarray
+    faces: np.ndarray
+    bary: np.ndarray
+    held: np.ndarray
+    guided: dict[int, np.ndarray]
+
+    @classmethod
+    def placed(
+        cls,
+        mould: Mould,
+        points: np.ndarray,
+        held: np.ndarray,
+        guided: dict[int, np.ndarray] | None = None,
+    ) -> SlidingNodes:
+        """Nodes put onto the mould at the points nearest to ``points`` ``(n, 3)``."""
+        faces, bary, on = mould.project(points)
+        return cls(mould, on, faces, bary, np.asarray(held, dtype=bool), dict(guided or {}))
+
+    def basis(self) -> sp.csr_matrix:
+        """``T`` ``(3 n, k)``: the free tangent directions (two per sliding node, one per guided
+        node, none for held ones), one column each."""
+        n = len(self.positions)
+        bases = self.mould.tangent_bases(self.faces)  # (n, 3, 2)
+        normals = self.mould.normals[self.faces]
+        rows, cols, values = [], [], []
+        column = 0
+        for a in range(n):
+            if self.held[a]:
+                continue
+            if a in self.guided:
+                direction = np.cross(normals[a], self.guided[a])
+                vectors = [direction / np.linalg.norm(direction)]
+            else:
+                vectors = [bases[a, :, 0], bases[a, :, 1]]
+            for v in vectors:
+                rows.extend(3 * a + np.arange(3))
+                cols.extend([column] * 3)
+                values.extend(v)
+                column += 1
+        return sp.csr_matrix((values, (rows, cols)), shape=(3 * n, column))
+
+    def moved(self, step: np.ndarray) -> SlidingNodes:
+        """The nodes moved by ``step`` ``(n, 3)`` (tangential) and put back onto the mould; held
+        nodes stay where they are."""
+        target = self.positions + step
+        faces, bary, on = self.mould.project(target)
+        on[self.held] = self.positions[self.held]
+        faces[self.held] = self.faces[self.held]
+        bary[self.held] = self.bary[self.held]
+        return SlidingNodes(self.mould, on, faces, bary, self.held, self.guided)
+
+
+def turned_over(
+    positions: np.ndarray, faces: np.ndarray, triangles: np.ndarray, normals: np.ndarray
+) -> np.ndarray:
+    """Ids of the blank's ``triangles`` ``(m, 3)`` that face away from the mould: their area
+    vector at ``positions`` against the mean normal of the faces ``(n,)`` their nodes lie in
+    (``normals`` ``(f, 3)`` per mould face)."""
+    p = positions[triangles]
+    area = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    mean = normals[faces[triangles]].sum(axis=1)
+    return np.flatnonzero(~(np.einsum("mi,mi->m", area, mean) > 0))
