@@ -15,12 +15,26 @@ import numpy as np
 from ..geometry.orientation import warp_deviation
 from ..materials import Fibres
 from ..mechanics.problem import Problem
-from .newton import Failure, NewtonContext, newton
+from .newton import Failure, NewtonContext
+from .strategies import Attempt, follow_plan
 
-__all__ = ["ALIGNMENT_TOLERANCE", "align_warp", "fibre_angle", "initial_fibres", "rotated"]
+__all__ = [
+    "ALIGNMENT_TOLERANCE",
+    "TURNED",
+    "align_warp",
+    "fibre_angle",
+    "initial_fibres",
+    "rotated",
+]
 
 #: The mean erected warp follows a prescribed direction to this angle (radians).
 ALIGNMENT_TOLERANCE = 1e-10
+#: How each turn of the yarns is solved from the previous pattern: globalised Newton, then
+#: damping from where it stopped.
+TURNED = (
+    Attempt("warp alignment", None, "line-search"),
+    Attempt("warp alignment, damped", None, "damped"),
+)
 
 
 def fibre_angle(vector: np.ndarray) -> float:
@@ -59,8 +73,9 @@ def align_warp(
     """Turn the fibres in the pattern until the mean erected warp follows ``direction``.
 
     Secant iteration on the warp angle (the deviation changes by about the same angle as the
-    warp); each new angle is solved by Newton from the previous pattern, whose rotation stays
-    held. Returns the pattern, the fibres and the final mean deviation (radians).
+    warp); each new angle is solved from the previous pattern, whose rotation stays held, by
+    the attempts :data:`TURNED` (:func:`~vares.solver.strategies.follow_plan`). Returns the
+    pattern, the fibres and the final mean deviation (radians).
     """
     problem = make_problem(fibres)
     offset = _offset(fibres)
@@ -74,12 +89,11 @@ def align_warp(
         fibres = Fibres.from_angles(new_theta, new_theta + offset)
         if problem.orientation_matters:
             problem = make_problem(fibres)
-            coordinates = ctx.attempt(
-                "warp alignment",
-                outer,
-                1.0,
-                lambda p=problem, x0=coordinates, s=outer: _solve_turned(p, x0, ctx, s, damping),
+            coordinates, _, reason = follow_plan(
+                problem, coordinates, None, TURNED, ctx, damping, step=outer
             )
+            if reason is not None:
+                raise Failure(reason, coordinates)
         new_deviation, _ = warp_deviation(problem.mesh, coordinates, fibres.warp, direction)
         if new_theta != theta and new_deviation != deviation:
             slope = (new_deviation - deviation) / np.radians(new_theta - theta)
@@ -91,22 +105,3 @@ def align_warp(
             coordinates,
         )
     return coordinates, fibres, deviation
-
-
-def _solve_turned(
-    problem: Problem, coordinates: np.ndarray, ctx: NewtonContext, outer: int, damping: float
-) -> np.ndarray:
-    """Newton for the turned yarns: globalised, and damped if that fails."""
-    try:
-        return newton(problem, coordinates, ctx, strategy="warp alignment", step=outer, tau=1.0)
-    except Failure:
-        return newton(
-            problem,
-            coordinates,
-            ctx,
-            strategy="warp alignment",
-            step=outer,
-            tau=1.0,
-            method="damped",
-            damping=damping,
-        )

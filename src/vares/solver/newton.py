@@ -34,6 +34,7 @@ __all__ = [
     "EXACT_TANGENT_BELOW",
     "METHODS",
     "ROUND_OFF_REGIME",
+    "AssembledDofs",
     "Failure",
     "NewtonContext",
     "at_round_off",
@@ -53,8 +54,9 @@ SQUEEZED_PATTERN = (
     "pattern would lap over itself there); cut the surface there (split it into panels) or add "
     "a dart"
 )
-#: ``"full"``: plain Newton; ``"line-search"``: globalised; ``"damped"``: Levenberg–Marquardt.
-METHODS = ("full", "line-search", "damped")
+#: ``"full"``: plain Newton; ``"line-search"``: globalised; ``"damped"``: Levenberg–Marquardt;
+#: ``"bounded"``: exact Newton steps shortened to keep every cell admissible.
+METHODS = ("full", "line-search", "damped", "bounded")
 
 
 def at_round_off(
@@ -68,6 +70,25 @@ def at_round_off(
     best = min(residuals[:-2])
     stalled = residuals[-1] > 0.5 * best and residuals[-2] > 0.5 * best
     return stalled and step_lengths[-1] == 1.0 and step_lengths[-2] == 1.0
+
+
+@dataclass
+class AssembledDofs:
+    """The dof map of an objective whose evaluations come assembled: ``gradients`` a vector
+    over every entry of its state, ``hessians`` the matrix over the ``free`` ones (seam
+    matching's KKT system, whose state is every panel's coordinates and the multipliers)."""
+
+    free: np.ndarray
+
+    @property
+    def num_free(self) -> int:
+        return int(np.count_nonzero(self.free))
+
+    def vector(self, gradients: np.ndarray) -> np.ndarray:
+        return gradients
+
+    def matrix(self, hessians: sp.spmatrix) -> sp.spmatrix:
+        return hessians
 
 
 @dataclass
@@ -106,6 +127,9 @@ class NewtonContext:
     #: What a line search held back by a fold for :data:`SQUEEZED_ITERATIONS` iterations says
     #: (``{cells}``: the cells).
     squeezed: str = SQUEEZED_PATTERN
+    #: A further condition of convergence on the state (``None``: none): seam matching's seams
+    #: must have equal lengths on both sides to round-off as well.
+    accepts: Callable[[np.ndarray], bool] | None = None
 
     def __post_init__(self) -> None:
         #: the linear solver, reusing its factorisations where that is cheaper (inexact Newton)
@@ -201,6 +225,8 @@ def newton(
       lowers the energy without inverting a cell; ``c`` (starting at ``damping`` × the mean
       tangent diagonal) follows the gain ratio of actual to predicted decrease (Nielsen's rule)
       and is capped in proportion to the residual, so it vanishes as the iteration converges.
+    - ``"bounded"``: exact Newton steps, each shortened to 0.9 of the longest that keeps every
+      cell admissible; for an objective whose stationary point is a saddle (a Lagrangian).
 
     Raises :class:`Failure` when it does not converge.
     """
@@ -228,6 +254,8 @@ def newton(
         converged = residual <= ctx.residual_tolerance or at_round_off(
             residuals[floor_from:], step_lengths[floor_from:], ctx.round_off_regime
         )
+        if converged and ctx.accepts is not None:
+            converged = ctx.accepts(x)
         if converged and ctx.turning:  # a stationary rotation, or a minimum?
             exact = ctx.assembler.matrix(evaluation.hessians)
             converged = turning_minimum(x, ctx, exact, residual_vector)
@@ -255,6 +283,9 @@ def newton(
         )  # relative residuals: the same ratios
         if method == "full":
             x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector, eta)
+            evaluation = None
+        elif method == "bounded":
+            x, step_length, tangent = _bounded_step(problem, x, ctx, matrix, residual_vector)
             evaluation = None
         elif method == "damped":
             x, step_length, tangent = _damped_step(
@@ -314,6 +345,19 @@ def _full_step(problem, x, ctx, matrix, residual_vector, eta):
     if inverted.size:
         raise Failure(f"inverted elements: {describe_cells(inverted)}", x)
     return trial, 1.0, "exact"
+
+
+def _bounded_step(problem, x, ctx, matrix, residual_vector):
+    """An exact Newton step, shortened to 0.9 of the longest that keeps every cell admissible
+    (no line search: the objective's value need not fall, as a Lagrangian's at a saddle)."""
+    try:
+        delta = ctx.step(matrix, -residual_vector)
+    except SingularMatrixError as exc:
+        raise Failure(f"singular tangent ({exc})", x) from exc
+    full = np.zeros_like(x)
+    full.ravel()[ctx.assembler.free] = delta
+    alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
+    return x + alpha * full, alpha, "exact"
 
 
 def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Damping):

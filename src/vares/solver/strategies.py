@@ -78,10 +78,12 @@ def follow_plan(
     attempts: Sequence[Attempt],
     ctx: NewtonContext,
     damping: float,
+    step: int = 1,
 ) -> tuple[np.ndarray, list[str], str | None]:
     """Run the attempts until one converges: ``(pattern, names tried, reason of the last
     failure or None)``. A whole-surface attempt goes on from where the last one stopped (never
-    inverted, lower energy than the start); pseudo-time stepping starts again from ``start``."""
+    inverted, lower energy than the start); pseudo-time stepping starts again from ``start``.
+    ``step`` numbers the whole-surface attempts' records (the warp alignment's secant step)."""
     path: list[str] = []
     reason = folding = None
     x = resume = start
@@ -91,14 +93,14 @@ def follow_plan(
             if attempt.taus is None:
                 x = ctx.attempt(
                     attempt.name,
-                    1,
+                    step,
                     1.0,
                     lambda a=attempt, x0=resume: newton(
                         problem,
                         x0,
                         ctx,
                         strategy=a.name,
-                        step=1,
+                        step=step,
                         tau=1.0,
                         method=a.method,
                         damping=damping,

@@ -9,7 +9,9 @@ same length in both patterns:
     minimise Σ_panels Π_p(X_p)   subject to   |ΔX_a|² − |ΔX_b|² = 0 for every seam segment,
 
 by Newton's method on the Lagrangian (the KKT system, with the exact Hessians of the energies and
-of the constraints), started from the independently solved panels. It has converged when the
+of the constraints, :mod:`vares.structures.coupled`), started from the independently solved
+panels: the one Newton driver (:func:`vares.solver.newton.newton`) with exact steps shortened to
+keep every cell admissible, as the patterns and the erection use it. It has converged when the
 Lagrangian's gradient meets the solve tolerance (relative to the panels' reference force), or
 has stalled at its round-off floor (:func:`vares.solver.newton.at_round_off`), and every
 segment's two lengths agree to round-off: their difference is at most
@@ -20,24 +22,20 @@ shortest segment cannot be met on seams with short segments (seams through cells
 
 from __future__ import annotations
 
-import itertools
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..geometry.injectivity import pattern_area_misfit, pattern_overlap
 from ..materials import Hyperelastic
-from ..mechanics.assembly import Assembler
-from ..mechanics.problem import Problem
-from ..mechanics.rigid import rigid_modes
 from ..options import split_settings, takes_options
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
-from ..solver.linear import SingularMatrixError, get_solver
-from ..solver.newton import at_round_off
+from ..solver.linear import get_solver
+from ..solver.newton import AssembledDofs, Failure, NewtonContext, newton
+from .coupled import KKT, CoupledProblem, SeamMatching
 from .options import StructureOptions
 from .panels import Panel, width_across_warp
 from .seams import Seam, SeamReport, find_seams, seam_lengths, seam_reports
@@ -47,6 +45,7 @@ __all__ = [
     "ROUND_OFF",
     "CoupledProblem",
     "MatchingRecord",
+    "SeamMatching",
     "StructureResult",
     "solve_structure",
 ]
@@ -194,44 +193,43 @@ def _match(
     thickness: float,
     before: list[tuple[np.ndarray, np.ndarray]],
 ) -> StructureResult:
-    """Newton on the KKT system from the independent patterns (module docs)."""
+    """Newton on the KKT system from the independent patterns (module docs), by the one
+    Newton driver (:func:`vares.solver.newton.newton`, exact steps bounded to keep every cell
+    admissible)."""
     options = out.options
     coupled = CoupledProblem.build(out.results, material, thickness, out.seams)
-    coordinates = [r.material_coordinates.copy() for r in out.results]
-    multipliers = np.zeros(coupled.num_constraints)
-    solver = get_solver(options.linear_solver)
-    history: list[MatchingRecord] = []
-    reason, converged, alpha = None, False, 0.0
-    for iteration in range(options.max_iterations + 1):
-        gradient, constraint, matrix, _ = coupled.kkt(coordinates, multipliers)
-        residual = float(np.linalg.norm(gradient)) / coupled.force_scale
-        violation = coupled.violation(coordinates)
-        round_off = ROUND_OFF * np.finfo(float).eps * max(np.abs(x).max() for x in coordinates)
-        history.append(MatchingRecord(iteration, residual, violation, round_off, alpha))
-        stalled = at_round_off([h.residual for h in history], [h.step_length for h in history])
-        if (residual <= options.tolerance or stalled) and violation <= round_off:
-            converged = True
-            break
-        if iteration == options.max_iterations:
-            reason = f"seam matching: iteration limit ({options.max_iterations}) reached"
-            break
-        try:
-            solver.factorize(matrix)
-            step = solver.solve(-np.concatenate([gradient, constraint]))
-        except SingularMatrixError as exc:
-            reason = f"seam matching: singular KKT matrix ({exc})"
-            break
-        dx, dlam = step[: coupled.num_free], step[coupled.num_free :]
-        deltas = coupled.full(dx)
-        alpha = min(
-            [1.0]
-            + [
-                0.9 * p.admissible_step(x, d)
-                for p, x, d in zip(coupled.problems, coordinates, deltas, strict=True)
-            ]
+    objective = SeamMatching(coupled, [r.material_coordinates for r in out.results], ROUND_OFF)
+    ctx = NewtonContext(
+        assembler=AssembledDofs(objective.free),
+        linear_solver=get_solver(options.linear_solver),
+        residual_tolerance=options.tolerance * coupled.force_scale,
+        energy_noise=0.0,
+        force_scale=coupled.force_scale,
+        max_iterations=options.max_iterations,
+        history=[],
+        steps=[],
+        callback=None,
+        accepts=lambda state: objective.matched,
+    )
+    reason = None
+    try:
+        state = newton(
+            objective,
+            objective.start,
+            ctx,
+            strategy="seam matching",
+            step=1,
+            tau=1.0,
+            method="bounded",
         )
-        coordinates = [x + alpha * d for x, d in zip(coordinates, deltas, strict=True)]
-        multipliers = multipliers + alpha * dlam
+    except Failure as failure:
+        reason, state = f"seam matching: {failure.reason}", failure.coordinates
+    converged = reason is None
+    coordinates, _ = objective.split(state)
+    history = [
+        MatchingRecord(r.iteration, r.relative_residual, *checked, r.step_length)
+        for r, checked in zip(ctx.history, objective.checked, strict=True)
+    ]
     after = [seam_lengths(coordinates, s) for s in out.seams]
     results = []
     for panel, result, x, problem in zip(
@@ -269,162 +267,4 @@ def _match(
         energy=float(sum(r.energy for r in results)),
         iterations=len(history) - 1,
         history=history,
-    )
-
-
-class KKT(NamedTuple):
-    """The coupled problem at one point: the Lagrangian's gradient over the free dofs, the
-    constraint values (rotation rows first, then every seam segment), the KKT matrix
-    ``[[∇²L, Bᵀ], [B, 0]]`` and the total energy."""
-
-    gradient: np.ndarray
-    constraint: np.ndarray
-    matrix: sp.csr_matrix
-    energy: float
-
-
-@dataclass
-class CoupledProblem:
-    """The coupled problem: each panel's energy and free dofs, and one constraint row per
-    rotation-held panel and per seam segment."""
-
-    problems: list[Problem]
-    assemblers: list[Assembler]
-    rotation: list[np.ndarray | None]
-    offsets: np.ndarray  # free-dof offset of each panel
-    seams: list[Seam]
-    free_index: list[np.ndarray]  # per panel (n, 2): global free dof of each node coordinate, −1
-
-    @classmethod
-    def build(
-        cls, results: list[PatternResult], material: Hyperelastic, thickness: float, seams
-    ) -> CoupledProblem:
-        problems, assemblers, rotations = [], [], []
-        for result in results:
-            problem = Problem(
-                result.mesh, material, thickness, fibres=result.fibres, prestress=result.prestress
-            )
-            mode = result.orientation if problem.orientation_matters else "fixed"
-            free, rotation = rigid_modes(
-                result.material_coordinates, "held" if mode == "direction" else mode
-            )
-            problems.append(problem)
-            assemblers.append(Assembler(result.mesh, free))
-            rotations.append(rotation)
-        offsets = np.concatenate([[0], np.cumsum([a.num_free for a in assemblers])])
-        free_index = []
-        for assembler, offset in zip(assemblers, offsets, strict=False):
-            index = np.full(assembler.free.size, -1)
-            index[assembler.free] = offset + np.arange(assembler.num_free)
-            free_index.append(index.reshape(-1, 2))
-        return cls(problems, assemblers, rotations, offsets, seams, free_index)
-
-    @property
-    def num_free(self) -> int:
-        return int(self.offsets[-1])
-
-    @property
-    def num_rotations(self) -> int:
-        return sum(r is not None for r in self.rotation)
-
-    @property
-    def num_constraints(self) -> int:
-        return self.num_rotations + sum(s.segments for s in self.seams)
-
-    @property
-    def force_scale(self) -> float:
-        return float(sum(p.force_scale for p in self.problems))
-
-    def full(self, dx: np.ndarray) -> list[np.ndarray]:
-        """Per-panel coordinate changes ``(n, 2)`` from a step over the free dofs."""
-        out = []
-        for p, assembler in enumerate(self.assemblers):
-            delta = np.zeros(assembler.free.size)
-            delta[assembler.free] = dx[self.offsets[p] : self.offsets[p + 1]]
-            out.append(delta.reshape(-1, 2))
-        return out
-
-    def violation(self, coordinates: list[np.ndarray]) -> float:
-        """Largest length difference of a seam segment's two sides."""
-        worst = 0.0
-        for seam in self.seams:
-            a, b = seam_lengths(coordinates, seam)
-            worst = max(worst, float(np.abs(a - b).max()))
-        return worst
-
-    def kkt(self, coordinates: list[np.ndarray], multipliers: np.ndarray) -> KKT:
-        """The coupled problem at ``coordinates`` (one ``(n, 2)`` per panel) and
-        ``multipliers``."""
-        blocks, gradient, energy = [], np.zeros(self.num_free), 0.0
-        for p, (problem, assembler) in enumerate(zip(self.problems, self.assemblers, strict=True)):
-            evaluation = problem.evaluate(coordinates[p], order=2)
-            energy += evaluation.energy
-            g = assembler.vector(evaluation.gradients).ravel()[assembler.free]
-            gradient[self.offsets[p] : self.offsets[p + 1]] = g
-            blocks.append(assembler.matrix(evaluation.hessians))
-        hessian = sp.block_diag(blocks, format="coo")
-        rows, cols, values = [hessian.row], [hessian.col], [hessian.data]
-        b_rows, b_cols, b_values, constraint = [], [], [], []
-        row = 0
-        for p, rotation in enumerate(self.rotation):  # linear rows: no curvature
-            if rotation is None:
-                continue
-            b_rows.append(np.full(rotation.size, row))
-            b_cols.append(np.arange(self.offsets[p], self.offsets[p + 1]))
-            b_values.append(rotation)
-            constraint.append(np.zeros(1))
-            row += 1
-        for seam in self.seams:
-            k = seam.segments
-            segment_rows = row + np.arange(k)
-            lam = multipliers[segment_rows] if multipliers.size else np.zeros(k)
-            squared = []
-            for panel, nodes, sign in (
-                (seam.first, seam.nodes_first, 1.0),
-                (seam.second, seam.nodes_second, -1.0),
-            ):
-                delta = np.diff(coordinates[panel][nodes], axis=0)  # (k, 2)
-                ends = (self.free_index[panel][nodes[:-1]], self.free_index[panel][nodes[1:]])
-                squared.append(np.sum(delta**2, axis=1))
-                _constraint_terms(
-                    (b_rows, b_cols, b_values),
-                    (rows, cols, values),
-                    segment_rows,
-                    ends,
-                    delta,
-                    sign,
-                    lam,
-                )
-            constraint.append(squared[0] - squared[1])
-            row += k
-        n, m = self.num_free, row
-        jacobian = _csr(b_rows, b_cols, b_values, (m, n))
-        lagrangian_hessian = _csr(rows, cols, values, (n, n))
-        gradient = gradient + jacobian.T @ multipliers
-        matrix = sp.bmat([[lagrangian_hessian, jacobian.T], [jacobian, None]], format="csr")
-        return KKT(gradient, np.concatenate(constraint), matrix, energy)
-
-
-def _constraint_terms(jacobian, hessian, segment_rows, ends, delta, sign, lam) -> None:
-    """Add one side of a seam's segments: ``c = ±|Δ|²`` has the gradient ``±2Δ`` at the end
-    node and ``∓2Δ`` at the start node, and ``λ ∇²c = ±2λ [[I, −I], [−I, I]]`` per axis."""
-    (b_rows, b_cols, b_values), (rows, cols, values) = jacobian, hessian
-    for end, direction in zip(ends, (-1.0, 1.0), strict=True):
-        for axis in range(2):
-            dof = end[:, axis]
-            kept = dof >= 0
-            b_rows.append(segment_rows[kept])
-            b_cols.append(dof[kept])
-            b_values.append(2.0 * sign * direction * delta[kept, axis])
-    for (e1, s1), (e2, s2) in itertools.product(zip(ends, (-1.0, 1.0), strict=True), repeat=2):
-        for axis in range(2):
-            kept = (e1[:, axis] >= 0) & (e2[:, axis] >= 0)
-            rows.append(e1[kept, axis])
-            cols.append(e2[kept, axis])
-            values.append(2.0 * sign * s1 * s2 * lam[kept])
-
-
-def _csr(rows, cols, values, shape) -> sp.csr_matrix:
-    return sp.csr_matrix(
-        (np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))), shape=shape
     )
