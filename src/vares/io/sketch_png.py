@@ -40,14 +40,23 @@ def paint_png(
     ``ticks`` ``(axis, position in points, label)`` and ``title``, painted at ``dpi`` as PNG
     bytes; cells are rasterised at the picture's own pixels (:func:`vares.io.raster.rasterise`),
     lines at 3 × 3 samples a pixel."""
-    from PIL import Image, ImageDraw
-
-    from .raster import rasterise
+    from PIL import Image, ImageColor, ImageDraw
 
     k = dpi / POINT * SUPERSAMPLE  # samples per point
     width, height = size
     pixels = (round(width * dpi / POINT), round(height * dpi / POINT))
-    image = Image.new("RGB", (pixels[0] * SUPERSAMPLE, pixels[1] * SUPERSAMPLE), "#ffffff")
+    # the cells that come first are filled at the picture's own pixels, then each pixel
+    # becomes SUPERSAMPLE × SUPERSAMPLE samples (as pasting them on the samples would, at a
+    # ninth of the cost); lines and text are drawn on the samples
+    leading = 0
+    while leading < len(items) and isinstance(items[leading], FilledCells):
+        leading += 1
+    base = np.full((pixels[1], pixels[0], 3), 255, dtype=np.uint8)
+    for item in items[:leading]:
+        base[_covered(item, pixels, dpi)] = ImageColor.getrgb(item.colour)[:3]
+    image = Image.fromarray(base).resize(
+        (pixels[0] * SUPERSAMPLE, pixels[1] * SUPERSAMPLE), Image.Resampling.NEAREST
+    )
     draw = ImageDraw.Draw(image)
     left, top, w, h = axes
 
@@ -60,11 +69,9 @@ def paint_png(
     font, minus = _font(FONT_SIZE * k)
     title_font, _ = _font(TITLE_SIZE * k)
     arrows = []
-    for item in items:
-        if isinstance(item, FilledCells):  # pixel rows downwards, as the picture's
-            grid = (0.0, 0.0, 1.0, pixels[0], pixels[1])
-            covered = rasterise(item.cells, item.points * dpi / POINT, grid=grid).index >= 0
-            mask = Image.fromarray(covered.astype(np.uint8) * 255)
+    for item in items[leading:]:
+        if isinstance(item, FilledCells):
+            mask = Image.fromarray(_covered(item, pixels, dpi).astype(np.uint8) * 255)
             image.paste(item.colour, mask=mask.resize(image.size, Image.Resampling.NEAREST))
         elif isinstance(item, Lines):
             lw = stroke(item.width)
@@ -110,6 +117,14 @@ def paint_png(
     buffer = io.BytesIO()
     image.save(buffer, format="PNG", compress_level=compress_level, dpi=(dpi, dpi))
     return buffer.getvalue()
+
+
+def _covered(item: FilledCells, pixels: tuple[int, int], dpi: float) -> np.ndarray:
+    """The pixels (rows downwards, as the picture's) that the cells of ``item`` cover."""
+    from .raster import rasterise
+
+    grid = (0.0, 0.0, 1.0, pixels[0], pixels[1])
+    return rasterise(item.cells, item.points * dpi / POINT, grid=grid).index >= 0
 
 
 def _font(size: float):
