@@ -545,3 +545,8 @@ def test_a_rhino_structure_is_read_with_one_parse_and_repaired_as_asked(tmp_path
     with pytest.raises(MeshError, match=r"panels.3dm: object 'left': .*2 separate pieces"):
         load_input(_structure_job(tmp_path, repair_meshes=False))
     assert len(parses) == 2
+    from vares.io.rhino import read_3dm_stored
+
+    stored, units = read_3dm_stored(tmp_path / "panels.3dm")  # as stored, with the unit
+    assert len(parses) == 3 and units == "m"
+    assert [len(m.points) for m in stored] == [30, 30]  # the seams' copies still there

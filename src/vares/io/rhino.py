@@ -24,6 +24,7 @@ __all__ = [
     "read_3dm",
     "read_3dm_file",
     "read_3dm_raw",
+    "read_3dm_stored",
     "unit_system",
     "write_3dm",
 ]
@@ -175,6 +176,14 @@ def read_3dm_raw(path: str | Path) -> list[RawMesh]:
     return _raw_meshes(_model(path), Path(path))
 
 
+def read_3dm_stored(path: str | Path) -> tuple[list[RawMesh], str | None]:
+    """Every object's mesh as stored (:func:`read_3dm_raw`) and the file's length unit
+    (:func:`unit_system`), from one parse of the file."""
+    path = Path(path)
+    model = _model(path)
+    return _raw_meshes(model, path), _units(model, path)
+
+
 def read_3dm_file(path: str | Path, *, repair_meshes: bool = True) -> RhinoFile:
     """All meshes of a Rhino file, named (see the module docs), and its length unit, from one
     parse of the file. Each mesh is repaired as a mesh file is
@@ -191,10 +200,9 @@ def read_3dm_file(path: str | Path, *, repair_meshes: bool = True) -> RhinoFile:
         invalid mesh (naming the object).
     """
     path = Path(path)
-    model = _model(path)
-    units = _units(model, path)
+    stored, units = read_3dm_stored(path)
     out = []
-    for raw in _raw_meshes(model, path):
+    for raw in stored:
         try:
             fixed = repair(raw.points, raw.cells, weld=repair_meshes)
             if not fixed.cells:
