@@ -152,8 +152,8 @@ def test_seed_off_the_mould_is_refused():
 # ---------------------------------------------------------------------------------- hemisphere
 @pytest.fixture(scope="module")
 def hemisphere_pair():
-    mould = irregular_cap(100.0, 90.0, 20, 0.3, 1)
-    blank = rectangle_blank(120.0, 120.0, 4.0)
+    mould = irregular_cap(100.0, 45.0, 20, 0.3, 1)  # a 45° cap of R = 100 mm, edges 3.9 mm
+    blank = rectangle_blank(120.0, 120.0, 4.0)  # its corners lie beyond the cap's edge
     drape = drape_blank(mould, blank, FABRIC, seed=(0, 0, 100), warp_direction=(1, 0, 0))
     pattern = vares.solve(mould, FABRIC, 1.0, warp_direction=(1.0, 0.0, 0.0))
     return mould, drape, pattern
@@ -164,14 +164,16 @@ def test_hemisphere_forward_drape_reproduces_the_vares_pattern(hemisphere_pair):
     assert drape.converged, drape.reason
     assert pattern.converged
     polar = np.degrees(np.arccos(np.clip(mould.points[:, 2] / 100.0, -1, 1)))
-    near = polar < 30.0  # well inside the blank (its edges are 57° from the pole)
+    assert 0 < drape.excess_area < 0.05 * drape.blank.area  # the corners beyond the edge
+    near = polar < 30.0  # away from both edges: the blank's (34° from the pole) and the cap's
     c = against_pattern(
         drape, mould, pattern.material_coordinates, pattern.fields["shear_angle"], within=near
     )
-    assert c["nodes"] > 100
-    assert c["max_position_difference"] < 0.5  # mm
-    assert c["rms_shear_difference"] < 0.8  # degrees
-    assert abs(c["turn"]) < 0.5
+    # measured: 0.097 mm, 0.33°, 0.55° (docs/composites.md, Forward drape)
+    assert c["nodes"] > 300
+    assert c["max_position_difference"] < 0.2  # mm
+    assert c["rms_shear_difference"] < 0.5  # degrees
+    assert abs(c["turn"]) < 1.0
 
 
 def test_cli_drape_blank_writes_its_files(tmp_path):
@@ -193,3 +195,28 @@ def test_cli_drape_blank_writes_its_files(tmp_path):
     assert again.exit_code == 2 and "exist" in error_line(again)
     alone = run("drape-blank", mould, "--blank-length", 140, *fabric, "-o", tmp_path / "o2")
     assert alone.exit_code == 2 and "--blank-width" in error_line(alone)
+
+
+def test_blank_outline_from_dxf_and_the_cutting_drawing(tmp_path):
+    import ezdxf
+
+    from vares.io.blank_files import read_blank_outline, write_blank_dxf
+
+    ring = [(0, 0), (80, 0), (80, 30), (40, 50), (0, 30)]
+    document = ezdxf.new("R2010")
+    space = document.modelspace()
+    space.add_lwpolyline([(0, 0), (5, 0), (5, 5)], close=True)  # a small one: not the blank
+    space.add_lwpolyline(ring, close=True, dxfattribs={"layer": "BLANK"})
+    space.add_lwpolyline([(0, 0), (200, 0)])  # open: not an outline
+    document.saveas(tmp_path / "blank.dxf")
+    outline = read_blank_outline(tmp_path / "blank.dxf")
+    assert np.allclose(outline, ring)
+    assert np.allclose(read_blank_outline(tmp_path / "blank.dxf", layer="BLANK"), ring)
+    with pytest.raises(ValueError, match="no closed polyline on layer 'X'"):
+        read_blank_outline(tmp_path / "blank.dxf", layer="X")
+    blank = outline_blank(outline, 3.0)
+    lines = [np.array([[10.0, 0.0], [10.0, 30.0]])]
+    write_blank_dxf(tmp_path / "cut.dxf", blank, lines)
+    drawn = ezdxf.readfile(tmp_path / "cut.dxf").modelspace()
+    layers = sorted(e.dxf.layer for e in drawn)
+    assert layers == ["EXTENDED", "NET", "ROSETTE"]

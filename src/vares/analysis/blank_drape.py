@@ -20,15 +20,23 @@ sheared to 90°) go out from the nearest node it does reach along the net's yarn
 are smoothed on the mould until no cell faces away from it.
 
 **Newton's method on the mould.** Each iteration solves ``(Tᵀ K T) Δu = −Tᵀ g`` for the nodes'
-tangential moves (far from the solution with the point-wise positive semi-definite part of the
-tangent, near it the exact one), then puts the moved nodes back onto the mould and halves the
-step until the energy decreases (Armijo) and no cell faces away from the mould. A triangulated
-mould is flat in each face and kinked across its edges; a node that ends up on an edge sees a
-different tangent plane from either side, and the residual stalls at a floor that shrinks with
-the facets' angles. Where the unbalanced tangential force is below ``facet_tolerance`` of the
-forces the cells exert on their nodes (the root sum of squares over cells), such a stall (the residual not halved over
-:data:`STALL_WINDOW` iterations, or no step found) counts as the equilibrium; the summary
-gives both measures reached.
+tangential moves, then puts the moved nodes back onto the mould and halves the step until no
+cell faces away from the mould and the residual decreases (the exact tangent, used below a
+relative residual of :data:`EXACT_TANGENT_BELOW`: the iteration goes to the equilibrium nearest
+the start) or the energy does (Armijo; the point-wise positive semi-definite part of the
+tangent, used above it or where the exact step finds nothing). The residual, not the energy,
+rules near the start: a fabric with stiff yarns and weak shear pressed onto a doubly curved
+mould has lower-energy states than its drape, in which compressed yarns kink in the plane
+(Rosen's micro-buckling, at a yarn stress of about G12); a membrane without bending stiffness
+has nothing to stop them, and a line search on the energy walks into them.
+
+**Facets.** A triangulated mould is flat in each face and kinked across its edges. A node near
+an edge sees a different tangent plane on either side, and the residual stalls at a floor set
+by the facets' angles and by how many blank nodes lie on each facet. Where the unbalanced
+tangential force is below ``facet_tolerance`` of the forces the cells exert on their nodes (the
+root sum of squares over cells), a stall (the residual not halved over :data:`STALL_WINDOW`
+iterations, or no step found) ends the iteration as ``facet_limited``; the summary gives the
+residual and the unbalanced force reached.
 
 **Trim line and excess.** The mould is extended by a flange beyond its edge
 (:func:`vares.geometry.mould.mould_surface`) on which the blank's excess lies. The trim line is
@@ -88,7 +96,9 @@ class BlankDrapeResult:
     ``outwardness`` ``(n,)`` (< 0 on the mould). ``trim_lines``: polylines ``(k, 2)`` on the flat
     blank where it crosses the mould's edge; ``net_area`` and ``excess_area``: the blank's area
     on the mould and beyond its edge. ``history``: per iteration the relative residual, the
-    energy and the step length.
+    unbalanced tangential force (a share of the cells' forces), the energy and the step length.
+    ``converged``: an equilibrium to ``tolerance``, or (``facet_limited``) stopped by the mould's
+    facets below ``facet_tolerance`` (module docs).
     """
 
     blank: Blank
@@ -98,6 +108,7 @@ class BlankDrapeResult:
     start: np.ndarray
     converged: bool
     reason: str | None
+    facet_limited: bool
     history: list[dict[str, float]]
     elapsed: float
     material: Hyperelastic
@@ -137,6 +148,7 @@ class BlankDrapeResult:
         return {
             "converged": self.converged,
             "reason": self.reason,
+            "facet_limited": self.facet_limited,
             "iterations": self.iterations,
             "relative_residual": self.history[-1]["relative_residual"],
             "unbalanced_force": self.history[-1]["unbalanced"],
@@ -171,8 +183,8 @@ def drape_blank(
     warp_direction: np.ndarray,
     flange_width: float | None = None,
     tolerance: float = 1e-8,
-    facet_tolerance: float = 1e-3,
-    max_iterations: int = 200,
+    facet_tolerance: float = 1e-2,
+    max_iterations: int = 100,
     regularisation: float = 1e-6,
 ) -> BlankDrapeResult:
     """Drape ``blank`` onto ``mould`` from ``seed`` ``(3,)`` (a point on the mould, where the
@@ -215,7 +227,9 @@ def drape_blank(
         wrinkling=False,
         regularisation=regularisation,
     )
-    nodes, history, reason = _settle(problem, nodes, tolerance, facet_tolerance, max_iterations)
+    nodes, history, reason, facet_limited = _settle(
+        problem, nodes, tolerance, facet_tolerance, max_iterations
+    )
     fields = _fields(problem, nodes, blank, fibres)
     _, bary, _ = surface.project(nodes.positions)
     outwardness = surface.outward(nodes.faces, bary)
@@ -229,6 +243,7 @@ def drape_blank(
         start=start,
         converged=reason is None,
         reason=reason,
+        facet_limited=facet_limited,
         history=history,
         elapsed=time.perf_counter() - started,
         material=material,
@@ -246,7 +261,8 @@ def drape_blank(
 def _settle(
     problem: ErectionProblem, nodes: SlidingNodes, tolerance: float, facets: float, limit: int
 ):
-    """Newton's method on the mould (module docs): ``(nodes, history, reason or None)``."""
+    """Newton's method on the mould (module docs): ``(nodes, history, reason or None, whether
+    the facets stopped it)``."""
     n = len(nodes.positions)
     assembler = Assembler(problem.connectivity, np.ones(3 * n, dtype=bool), dofs_per_node=3)
     solver = get_solver()
@@ -271,20 +287,22 @@ def _settle(
             }
         )
         residuals = [h["relative_residual"] for h in history]
-        if relative <= tolerance or (unbalanced <= facets and _stalled(residuals)):
-            return nodes, history, None
+        if relative <= tolerance:
+            return nodes, history, None, False
+        if unbalanced <= facets and _stalled(residuals):
+            return nodes, history, None, True
         exact = relative < EXACT_TANGENT_BELOW
         try:
             step, exact = _direction(problem, evaluation, assembler, basis, residual, solver, exact)
         except SingularMatrixError as exc:
-            return nodes, history, f"singular tangent ({exc})"
+            return nodes, history, f"singular tangent ({exc})", False
         moved = _line_search(problem, assembler, nodes, step, residual, exact, noise)
         if moved is None and exact:  # the positive semi-definite step may still get on
             step, exact = _direction(problem, evaluation, assembler, basis, residual, solver, False)
             moved = _line_search(problem, assembler, nodes, step, residual, exact, noise)
         if moved is None:
             if unbalanced <= facets:
-                return nodes, history, None
+                return nodes, history, None, True
             return (
                 nodes,
                 history,
@@ -294,7 +312,14 @@ def _settle(
                 ),
             )
         nodes, history[-1]["step"] = moved
-    return nodes, history, f"iteration limit ({limit}) reached"
+    return nodes, history, f"iteration limit ({limit}) reached", False
+
+
+def _stuck(unbalanced: float) -> str:
+    return (
+        f"no step reduces the residual further; the unbalanced tangential force is "
+        f"{unbalanced:.3g} of the cells' forces"
+    )
 
 
 def _stalled(residuals: list[float]) -> bool:

@@ -28,10 +28,11 @@ SMOOTHING_SWEEPS = 200
 
 def kinematic_start(
     mould: Mould, blank: Blank, net: KinematicNet
-) -> tuple[np.ndarray, np.ndarray, dict[int, np.ndarray]]:
+) -> tuple[np.ndarray, np.ndarray, dict[int, tuple[np.ndarray, float]]]:
     """The blank's start positions ``(n, 3)`` on ``mould`` from ``net`` (module docs), the held
     nodes ``(n,)`` (the seed node) and the guided node: the blank node next to the seed along the
-    warp, kept in the plane of the warp and the normal at the seed (its unit normal)."""
+    warp, kept in the plane of the warp and the normal at the seed (its unit normal and
+    offset)."""
     X = blank.coordinates - blank.coordinates[blank.seed]
     start, reached = _on_net(net, X)
     if not reached[blank.seed]:
@@ -43,7 +44,8 @@ def kinematic_start(
     _untangle(mould, blank, start, extrapolated)
     held = np.zeros(len(X), dtype=bool)
     held[blank.seed] = True
-    return start, held, {_warp_node(blank, X): _warp_plane(net)}
+    normal = _warp_plane(net)
+    return start, held, {_warp_node(blank, X): (normal, float(start[blank.seed] @ normal))}
 
 
 def _on_net(net: KinematicNet, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -10,7 +10,8 @@ method keeps its rate once every node stays in its face.
 
 A **held** node does not move (the seed). A **guided** node moves only along the line where its
 face's plane meets a given plane (the warp's plane through the seed): it keeps the blank from
-turning about the seed.
+turning about the seed; after every move it is put back into the plane and onto the mould
+(:data:`GUIDE_STEPS` times: the plane crosses the mould nearly at right angles).
 """
 
 from __future__ import annotations
@@ -24,19 +25,23 @@ from ..geometry.mould import Mould
 
 __all__ = ["SlidingNodes", "turned_over"]
 
+#: Steps of putting a guided node back into its plane and onto the mould after each move.
+GUIDE_STEPS = 4
+
 
 @dataclass
 class SlidingNodes:
     """The nodes of a blank on a mould: ``positions`` ``(n, 3)`` on it, the ``faces`` ``(n,)``
-    they lie in, the ``held`` nodes ``(n,)`` bool, and ``guided``: node → unit normal ``(3,)`` of
-    the plane the node stays in."""
+    they lie in and their barycentric coordinates ``(n, 3)``, the ``held`` nodes ``(n,)`` bool,
+    and ``guided``: node → the plane it stays in, ``(unit normal (3,), offset)`` (the points
+    ``p`` with ``p · normal = offset``)."""
 
     mould: Mould
     positions: np.ndarray
     faces: np.ndarray
     bary: np.ndarray
     held: np.ndarray
-    guided: dict[int, np.ndarray]
+    guided: dict[int, tuple[np.ndarray, float]]
 
     @classmethod
     def placed(
@@ -44,7 +49,7 @@ class SlidingNodes:
         mould: Mould,
         points: np.ndarray,
         held: np.ndarray,
-        guided: dict[int, np.ndarray] | None = None,
+        guided: dict[int, tuple[np.ndarray, float]] | None = None,
     ) -> SlidingNodes:
         """Nodes put onto the mould at the points nearest to ``points`` ``(n, 3)``."""
         faces, bary, on = mould.project(points)
@@ -62,7 +67,7 @@ class SlidingNodes:
             if self.held[a]:
                 continue
             if a in self.guided:
-                direction = np.cross(normals[a], self.guided[a])
+                direction = np.cross(normals[a], self.guided[a][0])
                 vectors = [direction / np.linalg.norm(direction)]
             else:
                 vectors = [bases[a, :, 0], bases[a, :, 1]]
@@ -81,6 +86,12 @@ class SlidingNodes:
         on[self.held] = self.positions[self.held]
         faces[self.held] = self.faces[self.held]
         bary[self.held] = self.bary[self.held]
+        for node, (normal, offset) in self.guided.items():
+            point = on[node]
+            for _ in range(GUIDE_STEPS):  # back into its plane, on the mould
+                point = point - (point @ normal - offset) * normal
+                face, weights, point = (a[0] for a in self.mould.project(point[None]))
+            on[node], faces[node], bary[node] = point, face, weights
         return SlidingNodes(self.mould, on, faces, bary, self.held, self.guided)
 
 

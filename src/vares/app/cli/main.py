@@ -5,6 +5,7 @@ from __future__ import annotations
 import typer
 
 from .batch import batch
+from .blank import drape_blank
 from .cut import cut
 from .drape import drape
 from .erect import erect
@@ -27,6 +28,7 @@ app = typer.Typer(
 for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch, drape):
     app.command()(command)
 app.command()(laminate)
+app.command("drape-blank")(drape_blank)
 app.add_typer(fabric_app, name="fabric")
 
 
