@@ -216,21 +216,25 @@ def test_read_mesh_with_nan(tmp_path):
             read_mesh(path)
 
 
-@pytest.mark.parametrize("nodes", [40, 2500, 3500])
-def test_coincident_nodes_pairwise_and_by_k_d_tree_agree(nodes, monkeypatch):
-    """Small node sets are compared pair by pair, large ones through a k-d tree: both find the
-    same clusters (chains of nodes closer than the tolerance join), also across the switch."""
+@pytest.mark.parametrize("nodes", [40, 2500, 25000])
+@pytest.mark.parametrize("crowded", [False, True])
+def test_coincident_nodes_by_a_sweep_and_by_a_k_d_tree_agree(nodes, crowded, monkeypatch):
+    """Nodes are compared along a sweep (up to _SWEEP_NODES), else through a k-d tree; both
+    find the same clusters (chains of nodes closer than the tolerance join), also where every
+    node lies at one place along the sweep (the sweep then hands over to the tree)."""
     from vares.geometry import weld
 
     rng = np.random.default_rng(nodes)
     points = rng.random((nodes, 3))
+    if crowded:  # a plane across the sweep's direction
+        points -= np.outer(points @ weld._SWEEP, weld._SWEEP)
     near = rng.choice(nodes, 3 * (nodes // 15), replace=False).reshape(3, -1)
     for step in (1, 2):  # chains of three: each node within the tolerance of the one before
         points[near[step]] = points[near[step - 1]] + rng.normal(
-            scale=5e-5, size=(near.shape[1], 3)
+            scale=2e-5, size=(near.shape[1], 3)
         )
     merged = weld.coincident_nodes(points, 2e-4)
-    monkeypatch.setattr(weld, "_PAIRWISE_NODES", 0 if nodes <= 3000 else 10**6)
+    monkeypatch.setattr(weld, "_SWEEP_NODES", 0 if nodes <= 20_000 else 10**6)
     other = weld.coincident_nodes(points, 2e-4)
     np.testing.assert_array_equal(merged, other)
     assert (merged != np.arange(nodes)).sum() >= near.shape[1] * 2  # the chains were found

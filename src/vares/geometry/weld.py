@@ -59,25 +59,34 @@ def coincident_nodes(
     return first[label]
 
 
-#: Up to this many nodes, close pairs are found by comparing every pair (a few milliseconds);
-#: more go through a k-d tree (scipy.spatial, 0.1–0.25 s to import).
-_PAIRWISE_NODES = 3000
+#: Up to this many nodes, close pairs are found by a sweep along one direction (a few
+#: milliseconds); more, or nodes crowded along that direction, go through a k-d tree
+#: (scipy.spatial, 0.1–0.25 s to import).
+_SWEEP_NODES = 20_000
+
+#: A direction along which no mesh's nodes line up (grids, planes of constant x, y or z).
+_SWEEP = np.array([1.0, np.sqrt(2.0), np.pi]) / np.sqrt(3.0 + np.pi**2)
 
 
 def _close_pairs(points: np.ndarray, tolerance: float) -> np.ndarray:
     """The pairs ``(i, j)``, ``i < j``, of points at most ``tolerance`` apart, ``(k, 2)``."""
-    if len(points) > _PAIRWISE_NODES:
-        from scipy.spatial import cKDTree
+    n = len(points)
+    if n <= _SWEEP_NODES:
+        # nodes sorted along the sweep: only those within the tolerance along it can be close
+        along = points @ _SWEEP
+        order = np.argsort(along, kind="stable")
+        ends = np.searchsorted(along[order], along[order] + tolerance, side="right")
+        counts = ends - np.arange(n) - 1
+        if counts.sum() <= 50 * n:
+            first = np.repeat(np.arange(n), counts)
+            offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+            i, j = order[first], order[first + 1 + offset]
+            close = np.linalg.norm(points[i] - points[j], axis=1) <= tolerance
+            pairs = np.sort(np.column_stack([i[close], j[close]]), axis=1)
+            return pairs.astype(np.int64)
+    from scipy.spatial import cKDTree
 
-        return cKDTree(points).query_pairs(tolerance, output_type="ndarray")
-    found = []
-    for start in range(0, len(points), 500):  # rows of at most 500 × n distances at a time
-        block = points[start : start + 500]
-        distance = np.linalg.norm(block[:, None, :] - points[None, :, :], axis=2)
-        i, j = np.nonzero(distance <= tolerance)
-        i += start
-        found.append(np.column_stack([i, j])[i < j])
-    return np.concatenate(found).astype(np.int64) if found else np.empty((0, 2), np.int64)
+    return cKDTree(points).query_pairs(tolerance, output_type="ndarray")
 
 
 def weld(meshes: Sequence[SurfaceMesh], tolerance: float | None = None) -> Welded:
