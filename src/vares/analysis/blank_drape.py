@@ -303,14 +303,7 @@ def _settle(
         if moved is None:
             if unbalanced <= facets:
                 return nodes, history, None, True
-            return (
-                nodes,
-                history,
-                (
-                    f"the line search found no step that lowers the energy (relative residual "
-                    f"{relative:.3g})"
-                ),
-            )
+            return nodes, history, _stuck(unbalanced), False
         nodes, history[-1]["step"] = moved
     return nodes, history, f"iteration limit ({limit}) reached", False
 
