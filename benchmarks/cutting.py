@@ -6,7 +6,9 @@ Each case is the job of ``vares cut --example NAME --roll-width W --fabric pes-p
 --prestress 2,1.5 --allowance 20 …`` (the options are printed), run through the one runner; the
 script prints per case the strips, the widest pattern with its allowances, the worst cell angle,
 the seams (3D length, the line's length, pattern lengths), the nest's length, yield and waste,
-and the times; with ``--images`` it copies cut_lines.png and nest.png there.
+how it was made (laid in pairs, or searched for: whether the search ended by itself) and the
+times; with ``--images`` it copies cut_lines.png and nest.png there. ``--cases`` picks cases
+(``conic-tent-2.5-alone`` and ``-1.5-alone``: the tent's strips not planned in pairs).
 """
 
 from __future__ import annotations
@@ -41,6 +43,9 @@ CASES = {
                        "cable_allowance": 80.0, "high_edge_type": "clamp",
                        "clamp_allowance": 50.0},
 }  # fmt: skip
+# the tent's strips alone (as before strips were planned in pairs), to compare in one run
+for _name in ("conic-tent-2.5", "conic-tent-1.5"):
+    CASES[f"{_name}-alone"] = {**CASES[_name], "interlock": "never"}
 
 
 def run_case(name: str, settings: dict, out: Path) -> None:
@@ -54,7 +59,7 @@ def run_case(name: str, settings: dict, out: Path) -> None:
     elapsed = time.perf_counter() - started
     result = outcome.cut
     plan, nest = result.plan, result.nest
-    units = job.input.units
+    units = job.input.units or "m"
     print(
         f"strips {len(plan.panels)} ({result.options.seams}, {plan.family.kind}); layouts tried "
         f"{plan.evaluations}; strips tried {[(n, round(w, 4)) for n, w in plan.history]}; "
@@ -66,6 +71,11 @@ def run_case(name: str, settings: dict, out: Path) -> None:
         f"{result.surface_worst_angle:.2f}°); area panels/surface − 1 = "
         f"{result.panel_area / result.surface_area - 1:.1e}"
     )
+    if plan.interlock:
+        print(
+            f"in pairs: {result.notes}; roll estimates (strips, length) {plan.compared}; "
+            f"pair widths per plan {[round(w, 4) for w in result.rounds]}"
+        )
     worst = max(abs(s.length_3d / s.line_length - 1) for s in result.seams)
     match = max(abs(s.length_2d[0] - s.length_2d[1]) / s.length_2d[0] for s in result.seams)
     print(f"seams {len(result.seams)}: 3D length vs its line ≤ {worst:.2e}, sides ≤ {match:.1e}")
@@ -77,7 +87,13 @@ def run_case(name: str, settings: dict, out: Path) -> None:
     if nest is not None:
         print(
             f"nest: length {nest.length:.2f} {units}, yield {100 * nest.yield_:.1f} %, waste "
-            f"{100 * nest.waste:.1f} % ({nest.elapsed:.1f} s)"
+            f"{100 * nest.waste:.1f} % ({nest.method}, {nest.elapsed:.1f} s"
+            + (
+                f"; the search {'ended by itself' if nest.finished else 'stopped by its bound'}"
+                f" after {nest.search_time:.1f} s of {nest.time_limit:g})"
+                if nest.method == "search"
+                else ")"
+            )
         )
     print(
         f"converged {outcome.converged}; matching {result.structure.iterations} iterations; "

@@ -65,6 +65,11 @@ def cutting_details(outcome: JobOutcome) -> dict:
         "input_cells": plan.input_cells,
         "refined_cells": plan.refined_cells,
         "replaced_geodesics": plan.replaced_geodesics,
+        "interlock": plan.interlock,
+        "roll_estimates": {
+            kind: {"strips": strips, "length": length}
+            for kind, (strips, length) in plan.compared.items()
+        },
         "notes": result.notes,
         "worst_angle_degrees": plan.cut.worst_angle,
         "input_worst_angle_degrees": result.surface_worst_angle,
@@ -87,6 +92,11 @@ def cutting_details(outcome: JobOutcome) -> dict:
             "waste": nest.waste,
             "net_area": nest.net_area,
             "seconds": nest.elapsed,
+            "method": nest.method,
+            "search_seconds": nest.search_time,
+            "time_limit": nest.time_limit,
+            "seed": result.options.nest_seed,
+            "finished": nest.finished,
             "pieces": [
                 {
                     "panel": result.plan.panels[p.index].name,

@@ -138,6 +138,11 @@ class Job:
             raise JobError(f"{origin}: [input] needs exactly one of mesh, meshes or example")
         if "cut" in built and "structure" not in built:
             built["structure"] = StructureOptions()
+        if "cut" in built and built["structure"].roll_width not in (None, built["cut"].roll_width):
+            raise JobError(
+                f"{origin}: [structure] roll_width differs from [cut] roll_width: a cut job has "
+                "one roll width, [cut] roll_width (every strip, allowances included, fits it)"
+            )
         return cls(**built, base=base or Path.cwd())
 
     def to_dict(self, location: Path | None = None) -> dict[str, dict[str, Any]]:

@@ -27,7 +27,12 @@ from scipy.sparse.csgraph import connected_components
 from .mesh import SurfaceMesh
 from .surface_lines import CuttingError, SurfaceLine, check_triangles, mesh_edges, min_angles
 
-__all__ = ["CutMesh", "LinesMeetError", "cut_mesh"]
+__all__ = [
+    "CutMesh",
+    "LinesMeetError",
+    "cut_mesh",
+    "panel_regions",
+]
 
 #: Crossings closer than this fraction of the edge length to a node are moved onto the node, and
 #: so is a line that passes a cell's corner closer than this fraction of the cell's edges.
@@ -140,7 +145,7 @@ def cut_mesh(
     cells = np.vstack([triangles[kept], np.array(new_cells, dtype=np.int64).reshape(-1, 3)])
     cut = SurfaceMesh(points, {"triangle": cells})
     seam_edges = np.array(sorted(seams), dtype=np.int64).reshape(-1, 2)
-    ids = _panel_ids(cells, seam_edges, len(points)) if panels else np.zeros(len(cells), int)
+    ids = panel_regions(cells, seam_edges, len(points)) if panels else np.zeros(len(cells), int)
     return CutMesh(
         cut,
         ids,
@@ -419,8 +424,9 @@ def _smallest_angle(p, q, r, tiny: float) -> float:
     return math.degrees(smallest)
 
 
-def _panel_ids(cells: np.ndarray, seam_edges: np.ndarray, num_points: int) -> np.ndarray:
-    """Connected regions of cells, neighbours across every edge that is not a seam edge."""
+def panel_regions(cells: np.ndarray, seam_edges: np.ndarray, num_points: int) -> np.ndarray:
+    """Connected regions of triangles ``(m, 3)``, neighbours across every edge that is not one
+    of the ``seam_edges`` ``(k, 2)``: a region label per cell ``(m,)``."""
     sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2)
     keys = np.sort(sides, axis=1) @ np.array([num_points, 1], dtype=np.int64)
     owner = np.repeat(np.arange(len(cells)), 3)

@@ -29,7 +29,10 @@ from .layout import CELLS_ACROSS, StripPlan, plan_strips, strips_along_lines
 from .matching import StructureResult, solve_structure
 from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
+from .pair_nest import pair_nest
+from .pairing import choose_plan, pair_widths, split_lone_strip
 from .panels import Panel, width_across_warp
+from .seam_lines import SeamLine, seam_lines
 
 __all__ = ["CutResult", "PieceOutline", "SeamLine", "cut", "input_cells", "with_patterns"]
 
@@ -50,18 +53,6 @@ class PieceOutline:
     def area(self) -> float:
         x, y = self.seam[:, 0], self.seam[:, 1]
         return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-
-
-@dataclass(frozen=True)
-class SeamLine:
-    """A seam of the cut surface: its two panels, its 3D length, the length of the cutting line
-    it follows (as computed, before the cut, between the points nearest to the seam's ends) and
-    its pattern length on each side."""
-
-    panels: tuple[str, str]
-    length_3d: float
-    line_length: float
-    length_2d: tuple[float, float]
 
 
 @dataclass
@@ -124,6 +115,22 @@ class CutResult:
                 f"{plan.replaced_geodesics} of {len(plan.lines)} cutting lines are plane sections "
                 "in place of geodesics that ran towards a neighbour or along the boundary"
             )
+        if plan.interlock:
+            notes.append(
+                "the strips are planned to lie in pairs on the roll, head to tail, the warp along "
+                "one seam of each" + _estimates(plan.compared)
+            )
+        if plan.split is not None:
+            a, b = (plan.panels[k].name for k in plan.split)
+            notes.append(
+                f"the strip without a partner is cut across at half its length: {a} and {b} "
+                "lie side by side, the cross seam matched like every seam"
+            )
+        if self.nest is not None and not self.nest.finished:
+            notes.append(
+                f"the nesting search was stopped by its time bound ({self.nest.time_limit:g} s): "
+                "a longer one (nest_time) may nest shorter, and another run may nest otherwise"
+            )
         return notes
 
 
@@ -162,6 +169,13 @@ def cut(
     options, structure = split_settings(
         settings, [options or SolveOptions(), structure or StructureOptions()]
     )
+    if structure.roll_width not in (None, cutting.roll_width):
+        raise ValueError(
+            f"a cut has one roll width, the cut option roll_width ({cutting.roll_width:g}: every "
+            f"strip's cut outline, allowances included, fits it); the structure's "
+            f"({structure.roll_width:g}) differs: leave it unset"
+        )
+    structure = structure.replace(roll_width=cutting.roll_width)
     if (cutting.seams == "curves") != (lines is not None):
         raise CuttingError("seams = 'curves' and the cutting lines (lines=[…]) go together")
     started = time.perf_counter()
@@ -175,9 +189,10 @@ def cut(
             f"a per-cell prestress needs one row per cell of the surface ({mesh.num_cells}); "
             f"got {len(prestress)}"
         )
-    target, rounds = usable, []
+    target, rounds, paired = usable, [], None
     for _ in range(MAX_ROUNDS):
-        plan = _plan(surface, target, cutting, allowances, options, lines)
+        plan = _plan(surface, target, cutting, allowances, options, lines, paired)
+        paired = plan.interlock
         own = [
             {} if options.warp_direction is not None else {"warp_direction": tuple(w)}
             for w in plan.warps
@@ -202,12 +217,16 @@ def cut(
             width_across_warp(o.cut, r.fibres.warp)
             for o, r in zip(outlines, result.results, strict=True)
         ]
-        rounds.append(max(widths))
-        if not result.converged or max(widths) <= usable or lines is not None:
+        needs = widths
+        if plan.interlock:
+            warps = [r.fibres.warp for r in result.results]
+            needs = pair_widths([o.cut for o in outlines], warps, plan.split)
+        rounds.append(max(needs))
+        if not result.converged or max(needs) <= usable or lines is not None:
             break
         # the flattened widths underestimated the patterns': ask the flattening for less
-        target = max(plan.widths) * usable / max(widths) * (1.0 - 1e-3)
-    nested = _nest(outlines, widths, result, cutting, scale) if nest else None
+        target = max(plan.widths) * usable / max(needs) * (1.0 - 1e-3)
+    nested = _nest(outlines, widths, result, cutting, scale, plan) if nest else None
     return CutResult(
         plan,
         result,
@@ -256,6 +275,16 @@ def input_cells(
     return out
 
 
+def _estimates(compared: dict[str, tuple[int, float]]) -> str:
+    if "alone" not in compared or "pairs" not in compared:
+        return ""
+    (alone, length), (pairs, paired) = compared["alone"], compared["pairs"]
+    return (
+        f" ({pairs} strips in place of {alone}, by the flattened strips {paired:.4g} of roll "
+        f"in place of {length:.4g})"
+    )
+
+
 def _allowances(cutting: CutOptions, allowance: float, scale: float) -> dict[str, float]:
     """The allowance of every kind of edge, mesh units."""
     return {
@@ -264,16 +293,29 @@ def _allowances(cutting: CutOptions, allowance: float, scale: float) -> dict[str
     }
 
 
-def _nest(outlines, widths, result: StructureResult, cutting: CutOptions, scale: float):
-    """The pieces nested on the roll, or None where they are not patterns or too wide."""
+def _nest(outlines, widths, result: StructureResult, cutting: CutOptions, scale: float, plan):
+    """The pieces nested on the roll, or None where they are not patterns or too wide: strips
+    planned in pairs laid in pairs (:func:`~vares.structures.pair_nest.pair_nest`, where every
+    pair fits and turning is allowed), the others searched for (:func:`nest_pieces`)."""
     if not result.converged or max(widths) > usable_width(cutting.roll_width):
         return None
-    return nest_pieces(
+    cuts, areas, gap = (
         [o.cut for o in outlines],
+        [o.area for o in outlines],
+        scale * cutting.piece_gap,
+    )
+    if plan.interlock and cutting.allow_turn:
+        count = len(cuts)
+        pairs = [(k, k + 1) for k in range(0, count - 1, 2)] + [(count - 1,)] * (count % 2)
+        laid = pair_nest(cuts, cutting.roll_width, pairs, net_areas=areas, gap=gap)
+        if laid is not None:
+            return laid
+    return nest_pieces(
+        cuts,
         cutting.roll_width,
-        net_areas=[o.area for o in outlines],
+        net_areas=areas,
         allow_turn=cutting.allow_turn,
-        gap=scale * cutting.piece_gap,
+        gap=gap,
         time_limit=cutting.nest_time,
         seed=cutting.nest_seed,
     )
@@ -290,7 +332,7 @@ def with_patterns(cut_result: CutResult, structure: StructureResult) -> CutResul
         width_across_warp(o.cut, r.fibres.warp)
         for o, r in zip(outlines, structure.results, strict=True)
     ]
-    nest = _nest(outlines, widths, structure, cutting, scale)
+    nest = _nest(outlines, widths, structure, cutting, scale, cut_result.plan)
     return replace(
         cut_result,
         structure=structure,
@@ -301,7 +343,12 @@ def with_patterns(cut_result: CutResult, structure: StructureResult) -> CutResul
     )
 
 
-def _plan(surface, target, cutting: CutOptions, allowances, options, lines) -> StripPlan:
+def _plan(
+    surface, target, cutting: CutOptions, allowances, options, lines, paired: bool | None = None
+) -> StripPlan:
+    """The strips: along the user's lines, or planned alone or in pairs (option ``interlock``,
+    :func:`~vares.structures.pairing.choose_plan`; ``paired`` keeps an earlier plan's choice),
+    a lone strip of pairs cut across (:func:`~vares.structures.pairing.split_lone_strip`)."""
     if cutting.seams == "curves":
         from ..geometry.drawn_lines import curves_on_surface
 
@@ -311,18 +358,22 @@ def _plan(surface, target, cutting: CutOptions, allowances, options, lines) -> S
         plan.refinements, plan.input_cells = rounds, len(surface.cells["triangle"])
         plan.refined_cells = len(fine.cells["triangle"])
         return plan
-    edge_kind = cutting.edge_type
-    return plan_strips(
-        surface,
-        target,
-        seams=cutting.seams,
-        layout=cutting.layout,
-        direction=cutting.strip_direction,
-        seam_allowance=allowances["seam"],
-        edge_allowance=allowances[edge_kind],
-        warp_direction=options.warp_direction,
-        snap=cutting.snap,
-    )
+
+    def planned(interlock: bool) -> StripPlan:
+        return plan_strips(
+            surface,
+            target,
+            seams=cutting.seams,
+            layout=cutting.layout,
+            direction=cutting.strip_direction,
+            seam_allowance=allowances["seam"],
+            edge_allowance=allowances[cutting.edge_type],
+            warp_direction=options.warp_direction,
+            snap=cutting.snap,
+            interlock=interlock,
+        )
+
+    return split_lone_strip(choose_plan(planned, cutting.interlock, paired))
 
 
 def piece_outlines(
@@ -355,48 +406,3 @@ def piece_outlines(
         ring = allowance_outline(seam, [allowances[k] for k in kinds])
         outlines.append(PieceOutline(seam, tuple(kinds), ring))
     return outlines
-
-
-def _stretch(polyline: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
-    """Length of a polyline between the points nearest to ``start`` and ``end`` (the stretch of
-    a cutting line a seam follows: its ends may have been moved onto boundary nodes)."""
-    a, b = polyline[:-1], polyline[1:]
-    d = b - a
-    length = np.linalg.norm(d, axis=1)
-    cumulative = np.concatenate([[0.0], np.cumsum(length)])
-
-    def position(point: np.ndarray) -> float:
-        t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.maximum(length**2, 1e-300), 0, 1)
-        k = int(np.argmin(np.linalg.norm(a + t[:, None] * d - point, axis=1)))
-        return float(cumulative[k] + t[k] * length[k])
-
-    return abs(position(end) - position(start))
-
-
-def seam_lines(plan: StripPlan, structure: StructureResult) -> list[SeamLine]:
-    """The seams with their 3D lengths, the lengths of the lines they follow and their
-    pattern lengths on both sides."""
-    from scipy.spatial import cKDTree
-
-    chains = [plan.cut.mesh.points[c] for c in plan.cut.lines]
-    owner = np.concatenate([np.full(len(c), k) for k, c in enumerate(chains)])
-    tree = cKDTree(np.vstack(chains)) if chains else None
-    out = []
-    for seam, report in zip(structure.seams, structure.seam_reports, strict=True):
-        nodes = structure.panels[seam.first].mesh.points[seam.nodes_first]
-        length_3d = float(np.linalg.norm(np.diff(nodes, axis=0), axis=1).sum())
-        line_length = float("nan")
-        if tree is not None:
-            _, found = tree.query(nodes)
-            line = int(np.bincount(owner[found]).argmax())
-            if line < len(plan.lines):
-                line_length = _stretch(plan.lines[line].points, nodes[0], nodes[-1])
-        out.append(
-            SeamLine(
-                (report.first, report.second),
-                length_3d,
-                line_length,
-                (report.length_first_after, report.length_second_after),
-            )
-        )
-    return out

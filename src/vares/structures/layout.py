@@ -23,6 +23,10 @@ if lines still meet where their crossings were moved onto the same node, it is r
 
 The flattened width is an estimate of the pattern's: :func:`vares.structures.cut.cut` checks the
 patterns themselves and plans again with a narrower target if one is too wide.
+
+Tapered strips can be planned to lie in pairs on the roll, head to tail (``interlock``): the
+warp of each runs along one of its seams, and the width that counts is the one two strips need
+side by side (:mod:`.widths`; when to, :mod:`.pairing`).
 """
 
 from __future__ import annotations
@@ -35,12 +39,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.cutting import SNAP, CutMesh, LinesMeetError, cut_mesh
-from ..geometry.flatten import lscm
 from ..geometry.line_families import LineFamily, geodesic_between_ends, line_family
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.refine import refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
-from .panels import Panel, split_panels, width_across_warp
+from .panels import Panel, split_panels
+from .widths import pattern_direction, strip_widths
 
 __all__ = [
     "APART",
@@ -77,6 +81,10 @@ class StripPlan:
     ``refinements`` is the number of rounds the surface was refined on its own faces before it
     was cut (``input_cells`` its triangles before, ``refined_cells`` after), and
     ``replaced_geodesics`` the number of geodesics replaced by their plane sections (module docs).
+    With ``interlock`` the strips are planned in pairs (``widths`` are pairs' widths);
+    ``lengths`` are the strips' extents along the warp, ``straight_pairs`` the widths their
+    pairs would need with one seam along the warp, ``compared`` the roll estimates of both
+    plans (:mod:`.pairing`) and ``split`` the two halves of a strip cut across, if any.
     """
 
     cut: CutMesh
@@ -91,6 +99,12 @@ class StripPlan:
     input_cells: int = 0
     refined_cells: int = 0
     replaced_geodesics: int = 0
+    interlock: bool = False
+    lengths: list[float] = field(default_factory=list)
+    straight_pairs: list[float] = field(default_factory=list)
+    compared: dict[str, tuple[int, float]] = field(default_factory=dict)
+    split: tuple[int, int] | None = None
+    straight_warp: bool = False
 
 
 def plan_strips(
@@ -105,12 +119,15 @@ def plan_strips(
     warp_direction: Sequence[float] | None = None,
     snap: float = SNAP,
     max_strips: int = 200,
+    interlock: bool = False,
 ) -> StripPlan:
     """The least number of equally wide strips whose flattened width, with a seam allowance on
     each seam side and ``edge_allowance`` on a side along the surface's boundary, is at most
     ``width`` (mesh units; module docs). ``warp_direction`` (3D) is measured across instead of
     the direction along each strip. The surface is refined on its own faces where its cells are
-    too large for strips of ``width``."""
+    too large for strips of ``width``. With ``interlock`` the strips are planned to lie in
+    pairs, head to tail: the warp runs along one seam of each (the same side of every strip,
+    unless ``warp_direction`` is given) and two of them must fit ``width`` side by side."""
     if seams not in SEAM_KINDS:
         raise CuttingError(f"seams must be one of {', '.join(SEAM_KINDS)}; got {seams!r}")
     if not width > 0:
@@ -121,14 +138,18 @@ def plan_strips(
     total = family.span[1] - family.span[0]
     if not family.closed:  # the whole surface, no line: the number of strips before refining
         whole = strips_along_lines(surface, [], snap, warp_direction, family)
-        estimate = sum(_widths(whole, family, seam_allowance, edge_allowance)) / width
+        estimate = sum(strip_widths(whole, family, seam_allowance, edge_allowance)) / width
         if estimate > max_strips:
             raise CuttingError(f"more than {max_strips} strips would be needed")
     refined = _Refined(surface, width)
 
     def evaluate(spans: np.ndarray) -> tuple[StripPlan, np.ndarray]:
         plan = refined.layout(family, spans, seams, snap, warp_direction)
-        plan.widths = _widths(plan, family, seam_allowance, edge_allowance)
+        if interlock and warp_direction is None:
+            plan.warps = _along_strips(plan.cut, plan.panels, family, one_seam=True)
+            plan.straight_warp = True
+        plan.interlock = interlock
+        plan.widths = strip_widths(plan, family, seam_allowance, edge_allowance)
         plan.input_cells = input_cells
         return plan, _gap_widths(plan, family, spans)
 
@@ -368,21 +389,28 @@ def strips_along_lines(
     return StripPlan(cut, panels, list(lines), warps, [], family)
 
 
-def _along_strips(cut: CutMesh, panels: list[Panel], family) -> list[np.ndarray]:
-    """Per panel: the sum of its seam segments (lines oriented alike), normalised."""
+def _along_strips(
+    cut: CutMesh, panels: list[Panel], family, one_seam: bool = False
+) -> list[np.ndarray]:
+    """Per panel: the sum of its seam segments (lines oriented alike), normalised; with
+    ``one_seam``, of one seam only, on the same side of every strip."""
     points, cells = cut.mesh.points, cut.mesh.cells["triangle"]
     n = len(points)
     sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2)
     owner = np.repeat(cut.panel_ids, 3)
     keys = sides[:, 0] * n + sides[:, 1]
     lookup = dict(zip(keys.tolist(), owner.tolist(), strict=True))
-    sums = np.zeros((len(panels), 3))
+    by_side = np.zeros((2, len(panels), 3))  # the seams a strip lies left of, and right of
     for chain in cut.lines:
         for u, w in itertools.pairwise(chain):
             vector = points[w] - points[u]
-            for key in (u * n + w, w * n + u):
+            for side, key in enumerate((u * n + w, w * n + u)):
                 if key in lookup:
-                    sums[lookup[key]] += vector
+                    by_side[side, lookup[key]] += vector
+    sums = by_side.sum(axis=0)
+    if one_seam:  # the seam on the strip's right (looking along it), where it has one
+        right = np.linalg.norm(by_side[0], axis=1)[:, None] > 0
+        sums = np.where(right, by_side[0], by_side[1])
     out = []
     for index, panel in enumerate(panels):
         length = np.linalg.norm(sums[index])
@@ -394,34 +422,4 @@ def _along_strips(cut: CutMesh, panels: list[Panel], family) -> list[np.ndarray]
             from ..geometry.flatten import projection_plane
 
             out.append(projection_plane(panel.mesh).axes[0])
-    return out
-
-
-def pattern_direction(mesh: SurfaceMesh, coordinates: np.ndarray, direction) -> np.ndarray:
-    """The unit 2D direction ``(2,)`` of a pattern ``(n, 2)`` that maps onto the 3D
-    ``direction`` (projected on each cell; 3D-area-weighted mean over the triangles)."""
-    cells = triangulated(mesh).cells["triangle"]
-    p, x = mesh.points[cells], coordinates[cells]
-    edges_3d = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]], axis=-1)  # (m, 3, 2)
-    edges_2d = np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]], axis=-1)  # (m, 2, 2)
-    mapping = edges_2d @ np.linalg.pinv(edges_3d)  # (m, 2, 3): tangent plane → pattern
-    area = 0.5 * np.linalg.norm(np.cross(edges_3d[..., 0], edges_3d[..., 1]), axis=1)
-    image = (mapping @ np.asarray(direction, dtype=float)) * area[:, None]
-    total = image.sum(axis=0)
-    return total / np.linalg.norm(total)
-
-
-def _widths(plan: StripPlan, family, seam_allowance: float, edge_allowance: float) -> list[float]:
-    """Flattened width of every strip with its two side allowances (module docs)."""
-    out = []
-    last = len(plan.panels) - 1
-    for index, (panel, warp) in enumerate(zip(plan.panels, plan.warps, strict=True)):
-        flat = lscm(panel.mesh)
-        width = width_across_warp(flat, pattern_direction(panel.mesh, flat, warp))
-        outer = family is not None and not family.closed and index in (0, last)
-        sides = 2 if last == 0 else 1
-        allowance = (
-            sides * edge_allowance + (2 - sides) * seam_allowance if outer else 2 * seam_allowance
-        )
-        out.append(width + allowance)
     return out

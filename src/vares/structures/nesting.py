@@ -7,6 +7,13 @@ reboot 2D nesting research"), a maintained strip-packing heuristic in Rust, thro
 bindings ``spyrrow`` (MIT), which bundle it with its collision engine jagua-rs (MPL-2.0). The
 result is checked independently here with shapely: no two pieces overlap, every piece lies
 inside the roll.
+
+The search is bounded by ``time_limit`` seconds and ends earlier by itself when it has stopped
+improving (sparrow's early termination: a number of attempts, not a time). It runs on one
+thread from ``seed``, so a search that ended by itself gives the same placements for the same
+outlines every time, on any machine as fast or slower; one stopped by its time bound ends
+where the time ran out, which depends on the machine's load (``RollNest.finished`` says
+which).
 """
 
 from __future__ import annotations
@@ -17,11 +24,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["NestError", "NestedPiece", "RollNest", "nest_pieces", "usable_width"]
+__all__ = [
+    "NestError",
+    "NestedPiece",
+    "RollNest",
+    "check_nest",
+    "clearance_of",
+    "nest_pieces",
+    "usable_width",
+]
 
 #: Clearance the nesting search keeps between pieces and to the roll's edges, relative to the
 #: roll width (the search works in single precision; the clearance makes the result exact).
 _CLEARANCE = 2e-5
+#: Shares of the time bound given to the search's exploration and to its compression.
+_EXPLORATION, _COMPRESSION = 0.5, 0.5
+#: A search counts as ended by itself if it took less than the shorter phase's bound by this
+#: share of it (sparrow checks its clock between moves).
+_MARGIN = 0.05
 
 
 class NestError(RuntimeError):
@@ -48,13 +68,18 @@ class NestedPiece:
 class RollNest:
     """Pieces on one roll: their placements, the length of roll used (from x = 0 to the end of
     the last piece), the net area (the patterns inside their seam lines) and the yield, net area
-    / (roll width × length)."""
+    / (roll width × length); the search's bound and time and whether it ended by itself (module
+    docs), and the ``method``: ``search`` or ``pairs`` (:mod:`.pair_nest`)."""
 
     roll_width: float
     length: float
     pieces: list[NestedPiece]
     net_area: float
     elapsed: float
+    time_limit: float = 0.0
+    search_time: float = 0.0
+    finished: bool = False
+    method: str = "search"
 
     @property
     def yield_(self) -> float:
@@ -64,6 +89,11 @@ class RollNest:
     def waste(self) -> float:
         """Fraction of the roll used that is cut away: 1 − yield."""
         return 1.0 - self.yield_
+
+
+def clearance_of(roll_width: float) -> float:
+    """The clearance kept between pieces and to the roll's edges on a roll of ``roll_width``."""
+    return _CLEARANCE * roll_width
 
 
 def usable_width(roll_width: float) -> float:
@@ -85,7 +115,8 @@ def nest_pieces(
     seed: int = 0,
 ) -> RollNest:
     """Lay the cut outlines ``(k_i, 2)`` (warp along +x) on a roll of ``roll_width`` (module
-    docs), ``gap`` apart, searching for ``time_limit`` seconds (at least one)."""
+    docs), ``gap`` apart, searching for ``time_limit`` seconds at most (rounded to whole
+    seconds, at least one) from ``seed``."""
     import spyrrow
     from shapely.geometry import Polygon
 
@@ -98,6 +129,7 @@ def nest_pieces(
                 f"piece {index + 1} is {np.ptp(shape[:, 1]):.6g} wide across the warp; a roll "
                 f"of {roll_width:g} takes at most {usable_width(roll_width):.6g}"
             )
+    config_seconds = max(1, round(time_limit))
     offsets = [shape.min(axis=0) for shape in shapes]  # sparrow likes pieces near the origin
     items = [
         spyrrow.Item(
@@ -113,17 +145,14 @@ def nest_pieces(
     )
     config = spyrrow.StripPackingConfig(
         early_termination=True,
-        total_computation_time=max(1, round(time_limit)),
+        total_computation_time=None,
+        exploration_time=max(1, round(_EXPLORATION * config_seconds)),
+        compression_time=max(1, round(_COMPRESSION * config_seconds)),
         min_items_separation=gap + clearance,
         num_workers=1,
         seed=seed,
     )
-    try:
-        solution = instance.solve(config)
-    except BaseException as exc:  # a panic in the Rust code arrives as a BaseException
-        if isinstance(exc, KeyboardInterrupt | SystemExit):
-            raise
-        raise NestError(f"the nesting search failed: {exc}") from None
+    solution, search_time, finished = _search(instance, config, config_seconds)
     pieces = []
     for placed in solution.placed_items:
         index = int(placed.id)
@@ -140,8 +169,31 @@ def nest_pieces(
     check_nest(placed_shapes, roll_width)
     length = max(s.bounds[2] for s in placed_shapes)
     return RollNest(
-        roll_width, length, pieces, float(sum(net_areas)), time.perf_counter() - started
+        roll_width,
+        length,
+        pieces,
+        float(sum(net_areas)),
+        time.perf_counter() - started,
+        float(config_seconds),
+        search_time,
+        finished,
     )
+
+
+def _search(instance, config, seconds: float):
+    """The solution, the search's wall time and whether it ended by itself: a phase stopped by
+    its bound ran for that long, so a search that took less than the shorter bound (by
+    ``_MARGIN``) was stopped by neither."""
+    started = time.perf_counter()
+    try:
+        solution = instance.solve(config)
+    except BaseException as exc:  # a panic in the Rust code arrives as a BaseException
+        if isinstance(exc, KeyboardInterrupt | SystemExit):
+            raise
+        raise NestError(f"the nesting search failed: {exc}") from None
+    elapsed = time.perf_counter() - started
+    shorter = min(config.exploration_time, config.compression_time).total_seconds()
+    return solution, elapsed, elapsed < (1 - _MARGIN) * shorter
 
 
 def _search_shape(shape: np.ndarray, clearance: float) -> list[tuple[float, float]]:

@@ -9,12 +9,14 @@ from ..geometry.cutting import SNAP
 from ..geometry.line_families import LAYOUTS
 from ..options import Options, OptionsError, option
 
-__all__ = ["EDGE_TYPES", "SEAM_LINES", "CutOptions", "StructureOptions"]
+__all__ = ["EDGE_TYPES", "INTERLOCK", "SEAM_LINES", "CutOptions", "StructureOptions"]
 
 #: Kinds of cutting lines: computed, or the user's curves.
 SEAM_LINES = ("geodesic", "planar", "curves")
 #: Kinds of panel edge along the surface's boundary (each has its own allowance).
 EDGE_TYPES = ("free", "cable", "clamp")
+#: Whether strips are planned to lie in pairs on the roll (``auto``: where that saves roll).
+INTERLOCK = ("auto", "always", "never")
 
 
 @dataclass(frozen=True)
@@ -33,7 +35,8 @@ class StructureOptions(Options):
     roll_width: float | None = option(
         None,
         "float",
-        "Usable fabric roll width (mesh units): panels wider across the warp are reported.",
+        "Usable fabric roll width (mesh units): panels whose patterns (inside the seam lines) "
+        "are wider across the warp are reported. A cut has its own (cut option roll_width).",
         section="structure",
         positive=True,
     )
@@ -54,7 +57,8 @@ class CutOptions(Options):
     roll_width: float = option(
         None,
         "float",
-        "Usable fabric roll width (mesh units): every strip, allowances included, fits it.",
+        "Usable fabric roll width (mesh units): every strip's cut outline, allowances "
+        "included, fits it.",
         section="cut",
         positive=True,
         optional=False,
@@ -109,6 +113,14 @@ class CutOptions(Options):
     free_allowance: float | None = _allowance("Allowance along free edges")
     cable_allowance: float | None = _allowance("Allowance along cable pockets")
     clamp_allowance: float | None = _allowance("Allowance along clamp edges")
+    interlock: str = option(
+        "auto",
+        "str",
+        "Plan tapered strips to lie in pairs on the roll, head to tail, the warp along one seam "
+        "of each: auto (where that saves at least a tenth of the roll), always or never.",
+        section="cut",
+        choices=INTERLOCK,
+    )
     allow_turn: bool = option(
         True,
         "bool",
@@ -119,11 +131,18 @@ class CutOptions(Options):
     nest_time: float = option(
         10.0,
         "float",
-        "Time for nesting the pieces on the roll (seconds).",
+        "Bound on the nesting search's time (seconds); a search that ends by itself within "
+        "half of it gives the same nest for the same input (strips in pairs need no search).",
         section="cut",
         positive=True,
     )
-    nest_seed: int = option(0, "int", "Seed of the nesting search.", section="cut", minimum=0)
+    nest_seed: int = option(
+        0,
+        "int",
+        "Seed of the nesting search (another seed, another search).",
+        section="cut",
+        minimum=0,
+    )
     piece_gap: float = option(
         0.0, "float", "Gap between nested pieces (DXF units).", section="cut", minimum=0
     )
@@ -141,6 +160,10 @@ class CutOptions(Options):
             raise OptionsError(None, "a curves file goes with seams = 'curves'")
         if self.curves_layer is not None and self.curves is None:
             raise OptionsError(None, "curves_layer needs a curves file")
+        if self.seams == "curves" and self.interlock == "always":
+            raise OptionsError(
+                "interlock", "strips along your own curves are not planned: use auto or never"
+            )
         if self.snap >= 0.5:
             raise OptionsError("snap", f"must be < 0.5; got {self.snap!r}")
 

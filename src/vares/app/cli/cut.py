@@ -55,7 +55,9 @@ def cut(
 
     The cutting lines (geodesics, plane sections or your curves) are placed so that every
     strip's pattern, allowances included, fits --roll-width (mesh units) with the least number
-    of strips; the warp runs along each strip (or along --warp-direction). Writes cut.json
+    of strips; the warp runs along each strip (or along --warp-direction). Tapered strips (a
+    conic tent's) are planned in pairs, head to tail, the warp along one seam of each, and laid
+    on the roll in pairs (--interlock). Writes cut.json
     (panels, widths, seams, nesting), nest.dxf (the pieces on the roll, for the cutter),
     nest.svg/.png, cut_lines.png, panels.vtu, structure.json and every strip's pattern files in
     a folder of its own.
