@@ -550,3 +550,23 @@ def test_a_rhino_structure_is_read_with_one_parse_and_repaired_as_asked(tmp_path
     stored, units = read_3dm_stored(tmp_path / "panels.3dm")  # as stored, with the unit
     assert len(parses) == 3 and units == "m"
     assert [len(m.points) for m in stored] == [30, 30]  # the seams' copies still there
+
+
+def test_a_single_rhino_surface_is_read_with_one_parse(tmp_path, monkeypatch):
+    """`vares pattern roof.3dm`: the mesh and the file's unit from one parse of the file."""
+    import rhino3dm
+
+    write_3dm(
+        tmp_path / "one.3dm", [NamedMesh("roof", "roof", hypar(size=4.0, rise=0.05, n=4))], "mm"
+    )
+    parses = []
+    read = rhino3dm.File3dm.Read
+
+    def counted(path):
+        parses.append(path)
+        return read(path)
+
+    monkeypatch.setattr(rhino3dm.File3dm, "Read", counted)
+    raw = read_mesh_file(tmp_path / "one.3dm")
+    assert len(parses) == 1
+    assert raw.units == "mm" and raw.surface().num_cells == 32

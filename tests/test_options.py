@@ -20,8 +20,7 @@ from vares.solver import SolveOptions
 from vares.structures import StructureOptions
 
 #: A run with every solver option away from its default but the orientation (an anisotropic
-#: law, so that the fibre options matter; let free, this fabric's pattern turns slowly along a
-#: flat valley of the energy and takes a thousand iterations).
+#: law, so that the fibre options matter; the orientation is held to keep the run short).
 SETTINGS = {
     "warp_angle": 15.0,
     "fill_angle": 105.0,

@@ -210,16 +210,15 @@ def read_raw(path: Path) -> RawSurface:
 
 
 def _read_3dm(path: Path) -> RawSurface:
-    from .rhino import read_3dm_raw, unit_system
+    from .rhino import read_3dm_stored
 
-    meshes = read_3dm_raw(path)
+    meshes, units = read_3dm_stored(path)  # one parse of the file
     if len(meshes) > 1:
         names = ", ".join(m.name for m in meshes)
         raise MeshError(
             f"{path} holds {len(meshes)} meshes ({names}); pattern them as panels ('vares panels')"
         )
     mesh = meshes[0]
-    units = unit_system(path)
     resolution = float(np.spacing(np.float32(np.abs(mesh.points).max())))
     return RawSurface(np.array(mesh.points), mesh.cells, units=units, resolution=resolution)
 
