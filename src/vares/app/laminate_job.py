@@ -31,6 +31,7 @@ materials::
     seed = [0.0, 0.0, 2.5]
     region = "zone"             # a cell field of the mould; region_value = 2 picks one value
     drop_off = 1
+    darts = "auto"              # or dart_lines = "darts.txt"; default: the laminate's darts
 
 Every table and key is checked against its options class; an unknown one is an error naming the
 closest valid spelling. ``[fibres] warp_direction`` is refused (each ply's orientation sets it),
@@ -150,7 +151,16 @@ class LaminateJob:
                 material = named[options.material]
             else:
                 material = default
-            plies.append(Ply(options, material))
+            lines = None
+            if options.dart_lines is not None:
+                from ..io.curves import read_curves
+
+                path = self.job.path(options.dart_lines)
+                try:
+                    lines = tuple(read_curves(path))
+                except (OSError, ValueError) as exc:
+                    raise JobError(f"[[ply]] {options.name} dart_lines: {exc}") from None
+            plies.append(Ply(options, material, lines))
         return plies
 
     def with_output(self, directory: str | Path) -> LaminateJob:

@@ -7,16 +7,18 @@ Into the job's output folder (replaced as a whole when the run succeeds, see
   the pattern) and the pair matrices of the ply-stack check;
 - ``laminate.md``: the same as tables (the ply stack, the drapes, the pair matrices);
 - ``laminate.vtu``: the mould with, per ply, the cell vectors ``<ply>_warp`` and ``<ply>_fill``
-  (unit, draped by the mechanical pattern), the cell field ``<ply>_shear_angle`` (degrees) and
+  (unit, draped by the mechanical pattern; a darted ply's read back on the mould's cells), the cell
+  field ``<ply>_shear_angle`` (degrees) and
   the kinematic net's ``<ply>_kinematic_warp``, ``<ply>_kinematic_fill`` and
   ``<ply>_kinematic_shear_angle``; NaN outside a ply's region;
 - ``orientations.inp``: the Abaqus orientation table, one ``*ORIENTATION`` per ply
   (:mod:`vares.io.orientations`); ``orientations.csv``: the same directions with element ids and
   the shear angle (those of the mechanical drape, or of the kinematic net with
   ``fe_directions = "kinematic"``);
-- ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields;
-- ``plies/<ply>.dxf``: each ply's cutter file, net and extended (trim) boundaries, rosette and
-  label (:mod:`vares.io.ply_dxf`); ``nest.dxf``: every ply nested on the roll (with a
+- ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields (a darted ply's
+  opened along its darts);
+- ``plies/<ply>.dxf``: each ply's cutter file, net and extended (trim) boundaries, rosette,
+  label and dart lines (:mod:`vares.io.ply_dxf`); ``nest.dxf``: every ply nested on the roll (with a
   ``roll_width``);
 - ``plybook.html``: the ply book (:mod:`vares.app.ply_book`).
 
@@ -220,6 +222,14 @@ def _matrix_lines(result: LaminateResult, value: str) -> list[str]:
     return [*lines, ""]
 
 
+def _darts_cell(drape: PlyDrapeResult) -> str:
+    if drape.darted is None:
+        return "–"
+    if not drape.is_darted:
+        return "none needed" if drape.darted.relieved else "none placed"
+    return f"{len(drape.darted.dart_lines)} ({drape.darted.max_shear_after:.2f}°)"
+
+
 def laminate_markdown(result: LaminateResult) -> str:
     """The run as Markdown tables: the stack, the drapes and the pair matrices."""
     options = result.laminate.options
@@ -247,8 +257,8 @@ def laminate_markdown(result: LaminateResult) -> str:
     lines += [
         "",
         "| drape | converged | iterations | energy | largest shear | kinematic largest shear "
-        "| mean difference | seconds |",
-        "|---|---|---|---|---|---|---|---|",
+        "| mean difference | darts (largest shear with them) | seconds |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for drape in result.drapes:
         data = drape.summary()
@@ -258,7 +268,7 @@ def laminate_markdown(result: LaminateResult) -> str:
         lines.append(
             f"| {drape.label} | {'yes' if drape.converged else 'no'} | {data['iterations']} | "
             f"{data['energy']:.6g} | {data['max_shear']:.2f}° | {k_max:.2f}° | {k_diff:.2f}° | "
-            f"{drape.seconds:.2f} |"
+            f"{_darts_cell(drape)} | {drape.seconds:.2f} |"
         )
     lines += ["", "## Ply-stack check", ""]
     for value in PAIR_VALUES:
@@ -321,8 +331,10 @@ def write_laminate(folder: OutputFolder, job: LaminateJob, run: LaminateRun) -> 
         write_ply_dxf(folder.staged(path), blank, units=run.units)
     vtu = [p for p in paths if p.parent.name == "patterns"]
     for drape, path in zip(result.drapes, vtu, strict=True):
-        pattern = drape.pattern
-        write_surface(folder.staged(path), drape.mesh, pattern.material_coordinates, pattern.fields)
+        pattern = drape.blank_pattern
+        write_surface(
+            folder.staged(path), drape.blank_mesh, pattern.material_coordinates, pattern.fields
+        )
 
 
 def run_laminate_job(
@@ -330,9 +342,12 @@ def run_laminate_job(
     *,
     force: bool = False,
     workers: int | None = None,
+    scheduler: str | None = None,
+    darts: str | None = None,
     callback: Callable[[PlyDrapeResult], None] | None = None,
 ) -> LaminateRun:
-    """Drape the job's laminate, cut and nest its plies and write its files (module docs)."""
+    """Drape the job's laminate, cut and nest its plies and write its files (module docs).
+    ``workers``, ``scheduler`` and ``darts`` replace the laminate table's."""
     loaded = load_input(job.job)
     mesh = loaded.panels[0].mesh
     inputs = [job.job.path(p) for p in job.job.input.paths]
@@ -342,7 +357,8 @@ def run_laminate_job(
         job.directory, laminate_files(job), force=force, inputs=inputs, command="laminate"
     )
     folder.check()
-    options = job.laminate if workers is None else job.laminate.replace(workers=workers)
+    changes = {"workers": workers, "scheduler": scheduler, "darts": darts}
+    options = job.laminate.replace(**{k: v for k, v in changes.items() if v is not None})
     result = drape_laminate(
         mesh,
         job.build_plies(),
@@ -366,7 +382,12 @@ def run_laminate(
     *,
     force: bool = False,
     workers: int | None = None,
+    scheduler: str | None = None,
+    darts: str | None = None,
     callback: Callable[[PlyDrapeResult], None] | None = None,
 ) -> LaminateResult:
     """:func:`run_laminate_job`'s draped laminate."""
-    return run_laminate_job(job, force=force, workers=workers, callback=callback).result
+    run = run_laminate_job(
+        job, force=force, workers=workers, scheduler=scheduler, darts=darts, callback=callback
+    )
+    return run.result

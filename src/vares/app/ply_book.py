@@ -5,11 +5,13 @@ The summary: every ply's orientation, thickness, areas, mass, largest shear and 
 stacking sequence with its thicknesses, the nest on the roll and the pair matrices of the
 ply-stack check. Each ply's section: its flat blank with the net and extended boundaries and the
 rosette (the 0° arrow along the warp, the 90° arrow along the fill, at the seed), its shear and
-producibility maps, its numbers, and its darts (none yet: a laminate's plies are not darted;
-the section says how much of the ply is at or beyond the locking angle).
+producibility maps (a darted ply's dart lines drawn on the blank and on both maps), its numbers,
+and its darts: their lengths on the mould, the mouths' openings in the blank and the largest
+shear before and after, or, without darts, how much of the ply is at or beyond the locking angle.
 
-Producibility here is that of the blank as cut: the mechanical drape's shear angle against the
-locking angle of the ply's fabric kind (warning from :class:`~vares.analysis.drape_options.
+Producibility here is that of the blank as cut (opened along its darts, if any): the mechanical
+drape's shear angle against the ply's locking angle (its own, the laminate's or its fabric
+kind's; warning from :class:`~vares.analysis.drape_options.
 DrapeOptions`' ``warn_fraction`` of it); the kinematic net's fractions stand beside it.
 """
 
@@ -22,7 +24,6 @@ import numpy as np
 
 from ..analysis.drape_options import DrapeOptions
 from ..analysis.producibility import CLASSES, Producibility, producibility
-from ..materials.forming import locking_angle
 from ..structures.laminate import LaminateResult, PlyDrapeResult
 from ..structures.laminate_blanks import PlyBlank
 from ..structures.laminate_pairs import PAIR_TITLES
@@ -38,17 +39,21 @@ _CLASS_COLOURS = ("#4caf50", "#ffb300", "#d32f2f", "#bdbdbd")
 
 
 def ply_producibility(result: LaminateResult, name: str) -> Producibility:
-    """The producibility of ply ``name``'s blank: its mechanical shear angle per cell of the
-    ply's mesh against the locking angle of its fabric kind (module docs)."""
+    """The producibility of ply ``name``'s blank as cut: its mechanical shear angle per cell of
+    the blank's mesh (opened along its darts, if any) against the ply's locking angle."""
     drape = result.drape(name)
-    ply = next(p for p in result.laminate.plies if p.name == name)
-    kind = ply.options.fabric_kind or result.laminate.options.fabric_kind
     return producibility(
-        drape.pattern.fields["shear_angle"],
-        drape.mesh.cell_areas(),
-        locking_angle(kind),
+        drape.blank_pattern.fields["shear_angle"],
+        drape.blank_mesh.cell_areas(),
+        drape.locking_angle,
         DrapeOptions().warn_fraction,
     )
+
+
+def _draw_darts(ax, blank: PlyBlank) -> None:
+    for index, dart in enumerate(blank.darts):
+        label = "darts" if index == 0 else None
+        ax.plot(dart[:, 0], dart[:, 1], color="#6a1b9a", lw=1.6, label=label)
 
 
 def _polygons(blank: PlyBlank) -> list[np.ndarray]:
@@ -73,6 +78,7 @@ def _blank_figure(blank: PlyBlank, units: str):
         PolyCollection(_polygons(blank), facecolor="#e3e8ef", edgecolor="none", antialiased=False)
     )
     _outline(ax, blank)
+    _draw_darts(ax, blank)
     size = float(np.ptp(blank.trim[0], axis=0).max())
     for direction, text, colour in (
         (blank.warp, "0° warp", "#1565c0"),
@@ -90,7 +96,10 @@ def _blank_figure(blank: PlyBlank, units: str):
         va = "bottom" if u[1] > 0.3 else "top" if u[1] < -0.3 else "center"
         ax.text(*(blank.origin + 1.05 * d), text, color=colour, ha=ha, va=va)
     ax.plot(*blank.origin, "o", color="black", ms=4)
-    ax.set_title(f"{blank.name}: flat blank, net (black) and trim (red, +{blank.allowance:g})")
+    darts = f", {len(blank.darts)} dart(s) (purple)" if blank.darts else ""
+    ax.set_title(
+        f"{blank.name}: flat blank, net (black) and trim (red, +{blank.allowance:g}){darts}"
+    )
     ax.set_xlabel(f"along the warp [{units}]")
     ax.set_ylabel(f"[{units}]")
     return fig
@@ -109,6 +118,7 @@ def _producibility_figure(blank: PlyBlank, check: Producibility):
         PolyCollection(_polygons(blank), facecolor=faces, edgecolor="none", antialiased=False)
     )
     _outline(ax, blank)
+    _draw_darts(ax, blank)
     labels = {
         "ok": f"ok (< {check.warn_angle:g}°)",
         "warn": f"warn ({check.warn_angle:g}–{check.locking_angle:g}°)",
@@ -254,14 +264,6 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
         )
     state = rows.pop(3)  # its cell holds markup: not escaped
     ident = html.escape(blank.name)
-    limit = 100 * check.fractions["limit"]
-    darts = (
-        f"<p id='darts-{ident}'>No darts: a laminate's plies are not darted yet (vares drape "
-        "--darts darts a single ply). "
-        f"{limit:.1f} % of the ply's area is at or beyond the locking angle"
-        + (" (a dart or another seed or orientation is needed there)." if limit > 0 else ".")
-        + "</p>"
-    )
     return [
         f"<section class='ply' id='ply-{ident}'>",
         f"<h2>Ply {ident}: {blank.orientation:+g}°</h2>",
@@ -269,8 +271,53 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
         table(rows, ident=f"ply-table-{ident}"),
         *(part.replace("{ply}", ident) for part in figures[drape.label]),
         "<h3>Darts</h3>",
-        darts,
+        *_darts_part(drape, check, ident, units),
         "</section>",
+    ]
+
+
+def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: str) -> list[str]:
+    """The ply's darts: a table of their lengths and openings and the largest shear before and
+    after; or, without darts, how much of the ply is at or beyond the locking angle."""
+    limit = 100 * check.fractions["limit"]
+    darted = drape.darted
+    if darted is None or darted.after is None:
+        if darted is None:
+            why = "No darts (none asked for: darts = 'auto' or dart_lines)."
+        elif not darted.before.converged:
+            why = "No darts: the ply without darts did not converge."
+        else:
+            why = (
+                f"No darts needed: the largest shear, {number(darted.max_shear_before, 4)}°, "
+                f"is below the locking angle ({number(darted.locking_angle, 4)}°)."
+                if darted.max_shear_before < darted.locking_angle
+                else "No dart could be placed."
+            )
+        extra = " (a dart or another seed or orientation is needed there)." if limit > 0 else "."
+        text = f"{why} {limit:.1f} % of the ply's area is at or beyond the locking angle{extra}"
+        return [f"<p id='darts-{ident}'>{html.escape(text)}</p>"]
+    data = darted.summary()
+    rows = [
+        (k + 1, f"{number(length, 4)}", f"{number(opening, 4)}")
+        for k, (length, opening) in enumerate(
+            zip(data["dart_lengths"], data["mouth_openings"], strict=True)
+        )
+    ]
+    after = data["max_shear_after"]
+    state = "below" if darted.relieved else "still at or beyond"
+    text = (
+        f"{len(rows)} dart(s), {len(darted.rounds)} solve(s) with darts: the largest shear "
+        f"{number(darted.max_shear_before, 4)}° without darts, {number(after, 4)}° with them "
+        f"open, {state} the locking angle ({number(darted.locking_angle, 4)}°); "
+        f"{limit:.1f} % of the blank's area is at or beyond it."
+    )
+    return [
+        f"<p id='darts-{ident}'>{html.escape(text)}</p>",
+        table(
+            rows,
+            ("dart", f"length on the mould [{units}]", f"mouth opening [{units}]"),
+            ident=f"darts-table-{ident}",
+        ),
     ]
 
 
@@ -285,6 +332,8 @@ def _drape_figures(
     for _, drawing in plot_pattern_fields(
         blank.mesh, blank.coordinates, {"shear_angle": shear}, titles=titles, dpi=REPORT_DPI
     ):
+        if blank.darts:
+            _draw_darts(drawing.axes[0], blank)
         parts.append(figure(drawing, "shear angle of the blank", "figure-{ply}-shear", close=False))
     parts.append(
         figure(_producibility_figure(blank, check), "producibility", "figure-{ply}-producibility")
@@ -337,7 +386,7 @@ def ply_book(
         figures: dict[str, list[str]] = {}
         for blank, check in zip(blanks, checks, strict=True):
             if blank.drape not in figures:
-                shear = result.drape(blank.name).pattern.fields["shear_angle"]
+                shear = result.drape(blank.name).blank_pattern.fields["shear_angle"]
                 figures[blank.drape] = _drape_figures(blank, shear, check, units)
             parts += _ply_section(result, blank, check, units, figures)
     return "\n".join([*parts, "</body></html>"])

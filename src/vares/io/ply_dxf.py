@@ -9,6 +9,8 @@ along +x). Layers:
 ``ROSETTE``  at the ply's seed: a circle, the 0° arrow along the warp and the 90° arrow along
              the fill, each with its angle as text;
 ``LABEL``    the ply's name, orientation and areas;
+``DART``     the ply's darts (darted plies only): each dart's two lips from the mouth to the tip
+             and back, an open polyline;
 ``ROLL``     (nest only) the roll used: a rectangle from x = 0 to its length, its title.
 """
 
@@ -27,16 +29,20 @@ from .files import atomic_path
 __all__ = ["PLY_LAYERS", "ply_label", "write_ply_dxf", "write_ply_nest_dxf"]
 
 #: The layers and their colours (AutoCAD colour index).
-PLY_LAYERS = {"NET": 7, "TRIM": 1, "ROSETTE": 5, "LABEL": 2}
+PLY_LAYERS = {"NET": 7, "TRIM": 1, "ROSETTE": 5, "LABEL": 2, "DART": 6}
 
 
 def ply_label(blank: PlyBlank, units: str) -> list[str]:
-    """The lines of a ply's label: name, orientation, net area and trim allowance."""
-    return [
+    """The lines of a ply's label: name, orientation, net area and trim allowance, and the
+    number of darts when it has any."""
+    lines = [
         blank.name,
         f"orientation {blank.orientation:+g} deg",
         f"net {blank.net_area:.6g} {units}2, trim +{blank.allowance:g} {units}",
     ]
+    if blank.darts:
+        lines.append(f"{len(blank.darts)} dart(s)")
+    return lines
 
 
 def _document(units: str, layers: dict[str, int]):
@@ -73,6 +79,8 @@ def _draw(space, blank: PlyBlank, place, rotation: float, label_inside: bool, un
         space.add_lwpolyline(place(ring), close=True, dxfattribs={"layer": "NET"})
     for ring in blank.trim:
         space.add_lwpolyline(place(ring), close=True, dxfattribs={"layer": "TRIM"})
+    for dart in blank.darts:
+        space.add_lwpolyline(place(dart), dxfattribs={"layer": "DART"})
     low, high = blank.trim[0].min(axis=0), blank.trim[0].max(axis=0)
     size = float(np.max(high - low))
     angle = np.radians(rotation)

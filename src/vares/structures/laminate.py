@@ -14,10 +14,17 @@ pattern frame (where A's warp runs along +x). It reports per pair the area whose
 compressed (shortened by more than ``compression_strain``), the largest yarn compression and the
 deviation of the erected yarns from B's own drape (:mod:`.laminate_pairs`). Where each ply lies
 on the mould (its region's cells and mesh, its warp at the seed) is :mod:`.laminate_regions`.
+
+A ply with darts (``darts = "auto"`` or dart lines of its own) is cut open where its shear reaches
+its locking angle and solved again (:func:`vares.analysis.darts.solve_with_darts`): its blank,
+cutter file and ply book are of the opened pattern, its fibre directions per mould cell are read
+back from it, and the pair check stays with the ply's pattern without darts, on the mould's cells.
+How the plies are run (here, in local processes, on a Dask scheduler) is :mod:`.laminate_tasks`.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -26,16 +33,16 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.drape import PlyDrape, drape_ply
+from ..analysis.darts import DartedPattern
+from ..analysis.drape import PlyDrape
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
 from ..options import OptionsError, split_settings, takes_options
-from ..parallel import process_pool
-from ..solver.api import solve
 from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
 from .laminate_pairs import PAIR_VALUES, PairCheck, blank_used_for, draped_yarns, pair_check
 from .laminate_regions import cell_blocks, ply_warp, region_cells, submesh
+from .laminate_tasks import dart_task, drape_tasks, on_mould_cells, ply_locking_angle
 
 __all__ = [
     "PAIR_VALUES",
@@ -50,6 +57,7 @@ __all__ = [
     "blank_used_for",
     "drape_laminate",
     "draped_yarns",
+    "ply_locking_angle",
     "ply_warp",
 ]
 
@@ -62,10 +70,13 @@ PARALLEL_CELLS = 4000
 
 @dataclass(frozen=True)
 class Ply:
-    """A ply: its :class:`PlyOptions` and its material (a hyperelastic law, thickness 1)."""
+    """A ply: its :class:`PlyOptions`, its material (a hyperelastic law, thickness 1) and the
+    dart lines of its own (``(k, 3)`` polylines on or near the mould, mouth or tip first; e.g.
+    the curves of its ``dart_lines`` file), if any."""
 
     options: PlyOptions
     material: Hyperelastic
+    dart_lines: tuple[np.ndarray, ...] | None = None
 
     @property
     def name(self) -> str:
@@ -100,10 +111,14 @@ class PlyDrapeResult:
     indices on the mould. ``seed``, ``warp_direction``, ``normal`` ``(3,)``: where it is laid and
     the warp there. ``pattern``: the mechanical drape (:func:`vares.solve`, warp along +x);
     ``kinematic``: the pin-jointed net beside it (``None`` when not asked for or failed, with
-    ``kinematic_error``). Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``,
-    ``fill`` (unit erected yarns of the pattern), ``shear_angle`` (degrees, the decrease of the
-    angle between the yarns) and the kinematic ``kinematic_warp``, ``kinematic_fill``,
-    ``kinematic_shear_angle``.
+    ``kinematic_error``). ``darted``: the ply with its darts open (``None`` without darts asked
+    for; its ``after`` is ``None`` when none was needed or placed) and ``locking_angle`` (degrees).
+    Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``, ``fill`` (unit erected
+    yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
+    laid (the darted pattern's, each mould cell the area-weighted mean of its pieces in the
+    opened mesh: :func:`~vares.structures.laminate_tasks.on_mould_cells`), and the kinematic
+    ``kinematic_warp``, ``kinematic_fill``, ``kinematic_shear_angle``. The pair check uses
+    ``pattern``, the ply without darts, on the mould's cells.
     """
 
     label: str
@@ -126,10 +141,27 @@ class PlyDrapeResult:
     kinematic_fill: np.ndarray
     kinematic_shear_angle: np.ndarray
     seconds: float
+    locking_angle: float = float("nan")
+    darted: DartedPattern | None = None
+
+    @property
+    def is_darted(self) -> bool:
+        """Whether the ply was cut open along darts (asked for, and placed)."""
+        return self.darted is not None and self.darted.after is not None
+
+    @property
+    def blank_mesh(self) -> SurfaceMesh:
+        """The mesh of the blank as cut: the ply's mesh opened along its darts, if any."""
+        return self.darted.slits.mesh if self.is_darted else self.mesh
+
+    @property
+    def blank_pattern(self) -> PatternResult:
+        """The pattern of the blank as cut (of :attr:`blank_mesh`)."""
+        return self.darted.after if self.is_darted else self.pattern
 
     @property
     def converged(self) -> bool:
-        return bool(self.pattern.converged)
+        return bool(self.pattern.converged and self.blank_pattern.converged)
 
     def summary(self) -> dict[str, Any]:
         """The numbers for a summary file."""
@@ -157,6 +189,8 @@ class PlyDrapeResult:
             data["kinematic_drape"]["against_pattern"] = self.kinematic.comparison(shear, area)
         elif self.kinematic_error is not None:
             data["kinematic_drape"] = {"error": self.kinematic_error}
+        data["locking_angle"] = self.locking_angle
+        data["darts"] = None if self.darted is None else self.darted.summary()
         return data
 
 
@@ -229,27 +263,6 @@ def _listed(matrix: np.ndarray) -> list[list[float | None]]:
     return [[float(v) if np.isfinite(v) else None for v in row] for row in matrix]
 
 
-def _drape_one(task: dict[str, Any]) -> dict[str, Any]:
-    """Drape one distinct ply (in a worker process or this one): the pattern and the net."""
-    started = time.perf_counter()
-    mesh = task["mesh"]
-    pattern = solve(
-        mesh, task["material"], 1.0, warp_direction=tuple(task["warp"]), **task["solve"]
-    )
-    kinematic, error = None, None
-    if task["kinematic"] is not None:
-        try:
-            kinematic = drape_ply(mesh, **task["kinematic"])
-        except Exception as exc:  # the net is beside the pattern: its failure is reported
-            error = f"{type(exc).__name__}: {exc}"
-    return {
-        "pattern": pattern,
-        "kinematic": kinematic,
-        "error": error,
-        "seconds": time.perf_counter() - started,
-    }
-
-
 def _label(orientation: float, taken: Sequence[str]) -> str:
     base = f"{orientation:g}°"
     label, count = base, 1
@@ -259,9 +272,15 @@ def _label(orientation: float, taken: Sequence[str]) -> str:
     return label
 
 
-def _key(ply: Ply, seed: np.ndarray, cells: np.ndarray) -> tuple:
+def _key(ply: Ply, seed: np.ndarray, cells: np.ndarray, darts: dict | None) -> tuple:
     o = ply.options
+    if darts is not None and darts["polylines"] is not None:
+        digest = hashlib.sha1(
+            b"".join(np.ascontiguousarray(p).tobytes() for p in darts["polylines"])
+        )
+        darts = {**darts, "polylines": digest.hexdigest()}
     return (
+        None if darts is None else tuple(sorted(darts.items())),
         round(float(o.orientation) % 360.0, 9),
         repr(ply.material.parameters) + type(ply.material).__name__,
         tuple(np.round(seed, 12)),
@@ -288,7 +307,8 @@ def drape_laminate(
     ``(m,)`` (a ply's ``region`` names one). ``solve_settings``: options of :func:`vares.solve`
     for every ply (not ``warp_direction``, which each ply sets). ``callback`` sees each drape as
     it ends. Distinct plies are draped in parallel by ``workers`` processes when more than one
-    (default: one per core for a mould of at least :data:`PARALLEL_CELLS` cells, else one).
+    (default: one per core for a mould of at least :data:`PARALLEL_CELLS` cells, else one), or
+    as tasks on the workers of the Dask scheduler at ``scheduler``.
     """
     (options,) = split_settings(settings, [options or LaminateOptions()])
     laminate = Laminate(tuple(plies), options)
@@ -316,12 +336,13 @@ def drape_laminate(
             seed = region[np.argmin(np.linalg.norm(region - target, axis=1))]
         else:
             seed = default_seed
-        key = _key(ply, seed, cells)
+        sub, nodes = submesh(mesh, cells)
+        darts = dart_task(ply, options, sub)
+        key = _key(ply, seed, cells, darts)
         ply_drape[o.name] = key
         if key in groups:
             groups[key]["plies"].append(o.name)
             continue
-        sub, nodes = submesh(mesh, cells)
         warp, normal = ply_warp(sub, seed, np.asarray(options.reference), o.orientation)
         kinematic = None
         if options.kinematic:
@@ -346,16 +367,14 @@ def drape_laminate(
                 "warp": warp,
                 "solve": solve_options,
                 "kinematic": kinematic,
+                "darts": darts,
             },
+            "locking_angle": ply_locking_angle(options, o),
         }
     tasks = [g["task"] for g in groups.values()]
     default = (os.cpu_count() or 1) if mesh.num_cells >= PARALLEL_CELLS else 1
     workers = min(options.workers or default, len(tasks))
-    if workers > 1:
-        with process_pool(workers) as pool:
-            outcomes = list(pool.map(_drape_one, tasks))
-    else:
-        outcomes = [_drape_one(task) for task in tasks]
+    outcomes, workers = drape_tasks(tasks, workers, options.scheduler)
     drapes = []
     for group, outcome in zip(groups.values(), outcomes, strict=True):
         drape = _drape_result(mesh, group, outcome)
@@ -390,10 +409,22 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         out[cells] = values
         return out
 
-    warp, fill = draped_yarns(
-        sub, pattern.material_coordinates, pattern.fibres.warp, pattern.fibres.fill
-    )
-    fields = pattern.fields
+    darted: DartedPattern | None = outcome["darted"]
+    shear = pattern.fields["shear_angle"]
+    if darted is not None and darted.after is not None:  # the ply as laid: opened, read back
+        opened, laid = darted.slits.mesh, darted.after
+        warp, fill = draped_yarns(
+            opened, laid.material_coordinates, laid.fibres.warp, laid.fibres.fill
+        )
+        origin, areas = darted.slits.cell_origin, opened.cell_areas()
+        count = sub.num_cells
+        warp = on_mould_cells(warp, origin, areas, count, unit=True)
+        fill = on_mould_cells(fill, origin, areas, count, unit=True)
+        shear = on_mould_cells(laid.fields["shear_angle"], origin, areas, count)
+    else:
+        warp, fill = draped_yarns(
+            sub, pattern.material_coordinates, pattern.fibres.warp, pattern.fibres.fill
+        )
     kinematic: PlyDrape | None = outcome["kinematic"]
     nan3 = np.full((len(cells), 3), np.nan)
     return PlyDrapeResult(
@@ -410,7 +441,7 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         pattern=pattern,
         warp=spread(warp),
         fill=spread(fill),
-        shear_angle=spread(fields["shear_angle"]),
+        shear_angle=spread(shear),
         kinematic=kinematic,
         kinematic_error=outcome["error"],
         kinematic_warp=spread(kinematic.drape.warp if kinematic else nan3),
@@ -419,4 +450,6 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
             kinematic.drape.shear_angle if kinematic else np.full(len(cells), np.nan)
         ),
         seconds=outcome["seconds"],
+        locking_angle=group["locking_angle"],
+        darted=darted,
     )

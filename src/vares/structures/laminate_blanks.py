@@ -8,6 +8,8 @@ nearest the ply's seed, with the warp (0°) and the fill (90°) of the ply's pat
 comes with its warp along +x, which is the roll's direction: the plies are nested as they are
 (or turned by 180°, which keeps the warp along the roll) by
 :func:`vares.structures.nesting.nest_pieces`.
+A darted ply's blank is its pattern opened along the darts: the darts' lips are part of its net
+boundary, and its ``darts`` are both lips of each, mouth → tip → mouth, in the pattern frame.
 A ply's mass is that of its flat blank: the areal weight (g/m², of the undeformed fabric) times
 the pattern's area.
 """
@@ -15,7 +17,7 @@ the pattern's area.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -44,7 +46,8 @@ class PlyBlank:
     the extended boundary's rings, likewise; ``origin`` ``(2,)``: the rosette's point (the
     pattern point of the mould node nearest the seed); ``warp``, ``fill`` ``(2,)``: the unit yarn
     directions of the pattern; ``net_area``, ``trim_area``: flat areas; ``surface_area``: the 3D
-    area of the ply on the mould; ``areal_weight`` (g/m²) and ``thickness`` (mm) when known.
+    area of the ply on the mould; ``areal_weight`` (g/m²) and ``thickness`` (mm) when known;
+    ``darts``: the open dart lines ``(k, 2)`` (both lips, mouth → tip → mouth), none undarted.
     """
 
     name: str
@@ -63,6 +66,7 @@ class PlyBlank:
     allowance: float
     areal_weight: float | None
     thickness: float | None
+    darts: list[np.ndarray] = field(default_factory=list)
 
     def mass(self, area: float, units: str) -> float | None:
         """Grams of fabric in ``area`` (mesh units², e.g. :attr:`net_area`) of mesh ``units``;
@@ -106,20 +110,21 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
     blanks = []
     for ply in result.laminate.plies:
         drape = result.drape(ply.name)
-        coordinates = drape.pattern.material_coordinates
-        loops = [coordinates[loop] for loop in drape.mesh.boundary_loops()]
+        mesh, pattern = drape.blank_mesh, drape.blank_pattern
+        coordinates = pattern.material_coordinates
+        loops = [coordinates[loop] for loop in mesh.boundary_loops()]
         loops.sort(key=lambda r: -abs(ring_area(r)))
         net = [r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)]
         trim = extended_boundary(net, allowance)
-        node = int(np.argmin(np.linalg.norm(drape.mesh.points - drape.seed, axis=1)))
-        fibres = drape.pattern.fibres
+        node = int(np.argmin(np.linalg.norm(mesh.points - drape.seed, axis=1)))
+        fibres = pattern.fibres
         o = ply.options
         blanks.append(
             PlyBlank(
                 name=ply.name,
                 drape=drape.label,
                 orientation=float(o.orientation),
-                mesh=drape.mesh,
+                mesh=mesh,
                 coordinates=coordinates,
                 net=net,
                 trim=trim,
@@ -132,6 +137,7 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
                 allowance=allowance,
                 areal_weight=o.areal_weight or options.areal_weight,
                 thickness=o.thickness or options.ply_thickness,
+                darts=drape.darted.dart_pattern_lines() if drape.is_darted else [],
             )
         )
     return blanks

@@ -15,7 +15,8 @@ __all__ = ["LaminateOptions", "PlyOptions"]
 @dataclass(frozen=True)
 class LaminateOptions(Options):
     """What the plies of a laminate share: the reference direction on the mould, the default
-    seed, the kinematic net's spacing, the ply-stack check's threshold and the workers."""
+    seed, the kinematic net's spacing, the ply-stack check's threshold, the darts and where the
+    plies are draped (local workers or a Dask scheduler)."""
 
     title = "laminate option"
 
@@ -79,6 +80,29 @@ class LaminateOptions(Options):
         section="laminate",
         positive=True,
     )
+    scheduler: str | None = option(
+        None,
+        "str",
+        "Address of a Dask distributed scheduler (tcp://host:port): the plies are draped as "
+        "tasks on its workers instead of local processes.",
+        section="laminate",
+    )
+    darts: str = option(
+        "none",
+        "str",
+        "Darts in every ply that names none: 'auto' places them where a ply's shear reaches its "
+        "locking angle and solves the ply again with them open (docs/composites.md, Darts).",
+        section="laminate",
+        choices=("none", "auto"),
+    )
+    locking_angle: float | None = option(
+        None,
+        "float",
+        "Locking angle in degrees, at most 90, of every ply that names none (default: the "
+        "fabric kind's): producibility and darts.",
+        section="laminate",
+        positive=True,
+    )
 
     areal_weight: float | None = option(
         None,
@@ -122,11 +146,18 @@ class LaminateOptions(Options):
     def check(self) -> None:
         if self.fe_directions == "kinematic" and not self.kinematic:
             raise OptionsError("fe_directions", "'kinematic' needs kinematic = true")
+        if self.scheduler is not None and self.workers is not None:
+            raise OptionsError(None, "give workers or a scheduler, not both")
+        if self.locking_angle is not None and self.locking_angle > 90.0:
+            raise OptionsError(
+                "locking_angle", f"must be at most 90 degrees; got {self.locking_angle}"
+            )
 
 
 @dataclass(frozen=True)
 class PlyOptions(Options):
-    """One ply of a laminate: its name, fabric, orientation, seed, region and drop-off order."""
+    """One ply of a laminate: its name, fabric, orientation, seed, region, drop-off order and
+    darts."""
 
     title = "ply option"
 
@@ -201,6 +232,29 @@ class PlyOptions(Options):
         positive=True,
     )
 
+    darts: str | None = option(
+        None,
+        "str",
+        "Darts in this ply: 'auto' or 'none' (default: the laminate's).",
+        section="ply",
+        choices=("none", "auto"),
+    )
+    dart_lines: str | None = option(
+        None,
+        "path",
+        "Dart lines of the ply's own: a curves file (points 'x y z', a blank line between two "
+        "lines, or a 3dm file), each from the ply's boundary into it; opened as they are.",
+        section="ply",
+    )
+    locking_angle: float | None = option(
+        None,
+        "float",
+        "Locking angle of the ply in degrees, at most 90 (default: the laminate's, else its "
+        "fabric kind's).",
+        section="ply",
+        positive=True,
+    )
+
     def check(self) -> None:
         if not self.name:
             raise OptionsError("name", "must be a non-empty string")
@@ -208,3 +262,9 @@ class PlyOptions(Options):
             raise OptionsError(None, "give a ply a fabric or a material, not both")
         if self.region_value is not None and self.region is None:
             raise OptionsError("region_value", "needs a region field")
+        if self.darts == "auto" and self.dart_lines is not None:
+            raise OptionsError(None, "give a ply darts = 'auto' or dart_lines, not both")
+        if self.locking_angle is not None and self.locking_angle > 90.0:
+            raise OptionsError(
+                "locking_angle", f"must be at most 90 degrees; got {self.locking_angle}"
+            )

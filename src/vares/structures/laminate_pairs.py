@@ -144,7 +144,8 @@ def pair_check(blank: PlyDrapeResult, ply: PlyDrapeResult, strain: float) -> Pai
     erected, _ = draped_yarns(
         blank.mesh, pattern.material_coordinates, check.fibres.warp, check.fibres.fill
     )
-    target = ply.warp[ply.cells]
+    own = ply.pattern  # the ply without darts, on the mould's cells
+    target, _ = draped_yarns(ply.mesh, own.material_coordinates, own.fibres.warp, own.fibres.fill)
     deviation = np.degrees(
         np.arctan2(
             np.linalg.norm(np.cross(erected, target), axis=1),

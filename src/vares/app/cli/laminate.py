@@ -6,6 +6,7 @@ from typing import Annotated
 import typer
 
 from .common import console, guarded
+from .flags import InputError
 
 __all__ = ["laminate"]
 
@@ -25,6 +26,22 @@ def laminate(
             "laminate table, else one per core for a mould of 4000 cells or more).",
         ),
     ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="Drape the plies as tasks on the Dask distributed scheduler at this address "
+            "(tcp://host:port) instead of local processes.",
+        ),
+    ] = None,
+    darts: Annotated[
+        str | None,
+        typer.Option(
+            "--darts",
+            help="'auto': darts in every ply that names none, where its shear reaches its "
+            "locking angle; 'none': no darts (default: the job's laminate table).",
+        ),
+    ] = None,
     force: Annotated[bool, typer.Option("--force", "-f", help="Overwrite output files.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Show no progress.")] = False,
 ) -> None:
@@ -33,11 +50,16 @@ def laminate(
     Writes laminate.json, laminate.md (the pair matrices), laminate.vtu (the draped warp and
     fill per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply),
     orientations.csv, patterns/drape_ANGLEdeg.vtu, plybook.html (the ply book), plies/PLY.dxf
-    (each ply's cutter file) and, with a roll_width, nest.dxf (every ply nested on the roll)
-    into the output directory. Exit status 1 when a ply did not converge.
+    (each ply's cutter file, its darts on layer DART) and, with a roll_width, nest.dxf (every
+    ply nested on the roll) into the output directory. Exit status 1 when a ply did not
+    converge.
     """
 
     def body() -> None:
+        if darts is not None and darts not in ("none", "auto"):
+            raise InputError(f"--darts must be 'auto' or 'none'; got {darts!r}")
+        if workers is not None and scheduler is not None:
+            raise InputError("give --workers or --scheduler, not both")
         from ..laminate_job import load_laminate_job
         from ..laminate_outputs import laminate_files, run_laminate_job
 
@@ -48,12 +70,26 @@ def laminate(
         def progress(drape) -> None:
             if not quiet:
                 state = "converged" if drape.converged else f"NOT converged: {drape.pattern.reason}"
+                dart_text = ""
+                if drape.is_darted:
+                    dart_text = (
+                        f", {len(drape.darted.dart_lines)} dart(s): largest shear "
+                        f"{drape.darted.max_shear_before:.2f}° -> "
+                        f"{drape.darted.max_shear_after:.2f}°"
+                    )
                 console.print(
                     f"  {drape.label} ({', '.join(drape.plies)}): {state}, "
-                    f"{drape.pattern.iterations} iterations, {drape.seconds:.2f} s"
+                    f"{drape.pattern.iterations} iterations, {drape.seconds:.2f} s{dart_text}"
                 )
 
-        run = run_laminate_job(job, force=force, workers=workers, callback=progress)
+        run = run_laminate_job(
+            job,
+            force=force,
+            workers=workers,
+            scheduler=scheduler,
+            darts=darts,
+            callback=progress,
+        )
         result = run.result
         if not quiet:
             _show(result)
