@@ -30,11 +30,12 @@ from ..materials.base import MaterialError
 from ..materials.compensation_law import compensating_law
 from ..materials.fabric_file import ConstantScatter
 from ..materials.presets import FabricPreset
-from ..options import Options, option
 from ..solver.api import solve
 from ..solver.result import PatternResult
+from .scatter_options import SAMPLED, ScatterOptions
 
 __all__ = [
+    "SAMPLED",
     "Band",
     "PatternBand",
     "ScatterOptions",
@@ -93,47 +94,6 @@ def pattern_dimensions(result: PatternResult) -> dict[str, float]:
         "boundary_length": boundary,
         "area": float(result.fields["pattern_area"].sum()),
     }
-
-
-#: What a band samples.
-SAMPLED = ("compensation", "constants")
-
-
-@dataclass(frozen=True)
-class ScatterOptions(Options):
-    """How the scatter of a fabric's compensation values is sampled and reported."""
-
-    title = "scatter option"
-
-    sampled: str = option(
-        "compensation",
-        "str",
-        "What is sampled: the measured compensation values (the pattern compensated by them) "
-        "or the fitted constants E1, E2, nu12 (the pattern compensated by the fitted law).",
-        section="scatter",
-        choices=SAMPLED,
-    )
-    samples: int = option(
-        16,
-        "int",
-        "Random samples of what is sampled, each solved (and erected) on its own.",
-        section="scatter",
-        minimum=1,
-    )
-    sigmas: float = option(
-        2.0,
-        "float",
-        "Half-width of the band reported, in standard deviations of the samples' figures.",
-        section="scatter",
-        minimum=0,
-    )
-    seed: int = option(
-        0,
-        "int",
-        "Seed of the random samples: the same seed draws the same samples.",
-        section="scatter",
-        minimum=0,
-    )
 
 
 def compensation_samples(

@@ -44,6 +44,10 @@ in :mod:`vares.options`); an unknown table or key is an error naming the closest
     roll_width = 2.5             # mesh units
     seams = "geodesic"           # or "planar", or "curves" with curves = "lines.3dm"
 
+    [scatter]                    # present: the fabric file's scatter carried into the patterns
+    samples = 16                 # random samples, each patterned (and erected) on its own
+    sigmas = 2.0                 # the band: nominal ± sigmas standard deviations
+
 Relative paths are relative to the job file's folder, so a job folder can be moved or shared.
 """
 
@@ -59,6 +63,7 @@ from typing import Any
 
 from ..analysis.drape_options import DrapeOptions
 from ..analysis.options import ErectionOptions
+from ..analysis.scatter_options import ScatterOptions
 from ..materials.fabric_file import toml_string
 from ..options import Options, OptionsError, Spec, suggest
 from ..solver.options import SolveOptions
@@ -84,9 +89,10 @@ SECTIONS: dict[str, str] = {
     "cut": "cut",
     "erection": "erection",
     "drape": "drape",
+    "scatter": "scatter",
 }
 #: Tables whose presence means something even when empty.
-_PRESENCE = ("structure", "cut", "erection", "drape")
+_PRESENCE = ("structure", "cut", "erection", "drape", "scatter")
 
 
 @dataclass(frozen=True)
@@ -94,7 +100,9 @@ class Job:
     """A patterning job: one options object per part; ``structure`` is set for a structure of
     several panels, ``cut`` (and ``structure``) for a surface cut into strips of roll width,
     ``erection`` when the structure is to be erected from its patterns after patterning,
-    ``drape`` when a ply is draped kinematically beside the pattern (a single surface).
+    ``drape`` when a ply is draped kinematically beside the pattern (a single surface),
+    ``scatter`` when the scatter of a fabric file is carried into the patterns (a band of
+    sampled patterns beside the run's own, :mod:`vares.app.run_band`).
     ``base`` is the folder relative paths are relative to; ``location`` the job file it was
     read from (if any)."""
 
@@ -107,6 +115,7 @@ class Job:
     cut: CutOptions | None = None
     erection: ErectionOptions | None = None
     drape: DrapeOptions | None = None
+    scatter: ScatterOptions | None = None
     base: Path = field(default_factory=Path.cwd)
     location: Path | None = None
 
@@ -202,6 +211,7 @@ _PARTS: dict[str, type[Options]] = {
     "cut": CutOptions,
     "erection": ErectionOptions,
     "drape": DrapeOptions,
+    "scatter": ScatterOptions,
 }
 
 
