@@ -13,8 +13,14 @@ solver's secant iteration.
     python benchmarks/locking.py --stabilisation 10                # 40 rings (9,600 cells)
     python benchmarks/locking.py --rings 20 30 40 60 --stabilisation 10   # mesh convergence
 
-(``--stabilisation c``: the share ``c G12/E`` of the yarn part kept per cell; ``--via 1e4``: the
-stiffer ratios solved from the pattern at E/G = 1e4; docs/locking.md.)
+    python benchmarks/locking.py --yarn-strain paired --ratios 1e6 --stabilisation 10 \
+        --continuation 1e2 1e4                                       # E/G 1e6 through 1e2, 1e4
+
+(``--stabilisation c``: the share ``c G12/E`` of the yarn part kept per cell;
+``--continuation``: the ratios solved first, each stage from the last pattern, ``--align-up-to``:
+the warp aligned at the stages up to this ratio and the rotation held above it; docs/locking.md.)
+The blank's extent along the warp, the fill and the two diagonals is compared with the net's
+pattern on the same mesh.
 """
 
 from __future__ import annotations
@@ -23,11 +29,15 @@ import argparse
 
 import numpy as np
 
-from vares.analysis.locking import cell_shear_angle, meridian_shear, solve_yarn_strain
+from vares.analysis.locking import (
+    blank_extent,
+    cell_shear_angle,
+    meridian_shear,
+    solve_yarn_strain,
+)
 from vares.geometry.drape import kinematic_drape
 from vares.geometry.examples import irregular_cap
-from vares.materials import OrthotropicStVenantKirchhoff
-from vares.solver.options import SolveOptions
+from vares.materials import Fibres, OrthotropicStVenantKirchhoff
 
 POLAR = (30.0, 45.0, 60.0, 75.0)
 #: Kinematic net on the exact sphere, seed at the pole, warp along x (docs/composites.md) [°].
@@ -49,39 +59,40 @@ def run(
     stabilisation: float,
     net: np.ndarray,
     start: np.ndarray,
-    via: float | None = None,
+    continuation: tuple[float, ...] = (),
+    align_up_to: float | None = None,
 ) -> dict:
-    """One solve; with ``via`` (a lower E/G) first at ``via`` with the warp aligned, then at
-    ``ratio`` from that pattern, its rotation held and its yarn angle kept."""
+    """One solve from the net's pattern, through the ratios of ``continuation`` below
+    ``ratio``."""
     mesh = irregular_cap(100.0, 90.0, rings, 0.3, 1)
-    iterations, seconds, options, direction = [], 0.0, None, (1, 0, 0)
-    for stage in ([via] if via is not None and via < ratio else []) + [ratio]:
-        material = OrthotropicStVenantKirchhoff(E1=stage, E2=stage, G12=1.0, nu12=0.0)
-        result = solve_yarn_strain(
-            mesh,
-            material,
-            yarn_strain=yarn_strain,
-            yarn_stabilisation=stabilisation / stage if yarn_strain != "element" else 0.0,
-            warp_direction=direction,
-            initial_guess=start,
-            options=options,
-        )
-        iterations.append(result.iterations)
-        seconds += result.elapsed
-        warp = np.degrees(np.arctan2(result.fibres.warp[1], result.fibres.warp[0]))
-        start, options, direction = result.coordinates, SolveOptions(warp_angle=warp), None
+    material = OrthotropicStVenantKirchhoff(E1=ratio, E2=ratio, G12=1.0, nu12=0.0)
+    result = solve_yarn_strain(
+        mesh,
+        material,
+        yarn_strain=yarn_strain,
+        yarn_stabilisation=stabilisation / ratio if yarn_strain != "element" else 0.0,
+        warp_direction=(1, 0, 0),
+        initial_guess=start,
+        continuation=tuple(r for r in continuation if r < ratio),
+        align_up_to=align_up_to,
+    )
     shear = cell_shear_angle(mesh, result.coordinates, material, result.fibres)
     table = meridian_shear(mesh, shear, polar_angles=POLAR)
+    extent = blank_extent(result.coordinates, result.fibres)
+    net_extent = blank_extent(start, Fibres.from_angles(0.0))
     return {
         "cells": mesh.num_cells,
         "converged": result.converged,
-        "iterations": " + ".join(str(i) for i in iterations),
-        "seconds": seconds,
+        "iterations": " + ".join(str(s.iterations) for s in result.stages),
+        "stage_seconds": " + ".join(f"{s.elapsed:.1f}" for s in result.stages),
+        "seconds": result.elapsed,
         "table": table,
         "spread": np.nanmax(table, axis=0) - np.nanmin(table, axis=0),
         "error": np.nanmax(np.abs(table - NET), axis=0),
         "mesh_error": np.nanmax(np.abs(table - net), axis=0),
         "mean": np.nanmean(table, axis=0),
+        "extent": extent,
+        "extent_error": extent - net_extent,
     }
 
 
@@ -97,10 +108,17 @@ def main() -> None:
         help="share of the yarn part kept per cell, times E/G (smoothed only)",
     )
     parser.add_argument(
-        "--via",
+        "--continuation",
+        type=float,
+        nargs="*",
+        default=[],
+        help="E/G ratios solved first, each from the last pattern (those below the ratio)",
+    )
+    parser.add_argument(
+        "--align-up-to",
         type=float,
         default=None,
-        help="solve at this E/G first, then at the higher ratios from that pattern",
+        help="align the warp at the stages up to this E/G, hold the rotation above it",
     )
     args = parser.parse_args()
     print("net (exact sphere)  " + "  ".join(f"{v:6.2f}" for v in NET))
@@ -112,14 +130,25 @@ def main() -> None:
             print(f"  meridian {azimuth:3d}°     " + "  ".join(f"{v:6.2f}" for v in line))
         spread = np.nanmax(net, axis=0) - np.nanmin(net, axis=0)
         print("  spread of the 4   " + "  ".join(f"{v:6.2f}" for v in spread))
+        extent = blank_extent(start, Fibres.from_angles(0.0))
+        print("  extent warp / fill / +45 / -45 [mm]  " + " / ".join(f"{v:.2f}" for v in extent))
         for ratio in args.ratios:
             for yarn_strain in args.yarn_strain:
-                r = run(rings, ratio, yarn_strain, args.stabilisation, net, start, args.via)
+                r = run(
+                    rings,
+                    ratio,
+                    yarn_strain,
+                    args.stabilisation,
+                    net,
+                    start,
+                    tuple(args.continuation),
+                    args.align_up_to,
+                )
                 rows.append((rings, ratio, yarn_strain, r))
                 print(
                     f"\n{rings} rings ({r['cells']} cells), E/G = {ratio:.0e}, {yarn_strain}: "
                     f"converged {r['converged']}, {r['iterations']} iterations, "
-                    f"{r['seconds']:.1f} s"
+                    f"{r['stage_seconds']} = {r['seconds']:.1f} s"
                 )
                 print("polar angle         " + "  ".join(f"{p:6.0f}" for p in POLAR))
                 for azimuth, line in zip((45, 135, 225, 315), r["table"], strict=True):
@@ -128,18 +157,26 @@ def main() -> None:
                 print("  mean of the 4     " + "  ".join(f"{v:6.2f}" for v in r["mean"]))
                 print("  max |Δ net|       " + "  ".join(f"{v:6.2f}" for v in r["error"]))
                 print("  max |Δ mesh net|  " + "  ".join(f"{v:6.2f}" for v in r["mesh_error"]))
+                print(
+                    "  extent warp / fill / +45 / -45 [mm]  "
+                    + " / ".join(f"{v:.2f}" for v in r["extent"])
+                    + "  (minus the net's: "
+                    + " / ".join(f"{v:+.2f}" for v in r["extent_error"])
+                    + ")"
+                )
     print(
         "\n| rings | cells | E/G | yarn strain | iterations | s | spread (30/45/60/75°) | "
-        "max abs. error vs net | vs the mesh's net |"
+        "max abs. error vs net | vs the mesh's net | extent − net's [mm] |"
     )
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for rings, ratio, yarn_strain, r in rows:
         spread = " / ".join(f"{v:.2f}" for v in r["spread"])
         error = " / ".join(f"{v:.2f}" for v in r["error"])
         mesh_error = " / ".join(f"{v:.2f}" for v in r["mesh_error"])
+        extent = " / ".join(f"{v:+.2f}" for v in r["extent_error"])
         print(
             f"| {rings} | {r['cells']} | {ratio:.0e} | {yarn_strain} | {r['iterations']} | "
-            f"{r['seconds']:.1f} | {spread} | {error} | {mesh_error} |"
+            f"{r['seconds']:.1f} | {spread} | {error} | {mesh_error} | {extent} |"
         )
 
 

@@ -2,9 +2,11 @@
 along the meridians of a cap (the intra-ply shear locking check of DESIGN.md §8).
 
 :func:`solve_yarn_strain` is :func:`vares.solve` with ``yarn_strain`` set (the solve assembles
-over the problem's connectivity), returning the problem beside the pattern;
-:func:`meridian_shear` samples a per-cell field along meridians of a surface of revolution about
-the z axis.
+over the problem's connectivity), returning the problem beside the pattern; with
+``continuation`` it reaches a stiff law through softer ones (:class:`ScaledYarns`, the yarn
+part of the law scaled), each stage started from the last pattern. :func:`meridian_shear`
+samples a per-cell field along meridians of a surface of revolution about the z axis;
+:func:`blank_extent` measures a pattern along its yarns and diagonals.
 """
 
 from __future__ import annotations
@@ -18,11 +20,34 @@ from ..geometry.mesh import SurfaceMesh
 from ..materials import Fibres, Hyperelastic
 from ..mechanics.fields import cell_fields
 from ..mechanics.problem import Problem
+from ..mechanics.yarn_laws import ScaledYarns, yarn_to_shear_ratio
 from ..solver.api import solve
 from ..solver.options import SolveOptions
 from ..solver.result import IterationRecord
 
-__all__ = ["SmoothedSolve", "cell_shear_angle", "meridian_shear", "solve_yarn_strain"]
+__all__ = [
+    "ContinuationStage",
+    "ScaledYarns",
+    "SmoothedSolve",
+    "blank_extent",
+    "cell_shear_angle",
+    "meridian_shear",
+    "solve_yarn_strain",
+    "yarn_to_shear_ratio",
+]
+
+
+@dataclass
+class ContinuationStage:
+    """One stage of a continuation: its yarn-to-shear ratio, stabilisation share, whether the
+    warp was aligned (else the rotation of the last stage held), and how the solve went."""
+
+    ratio: float
+    stabilisation: float
+    aligned: bool
+    converged: bool
+    iterations: int
+    elapsed: float
 
 
 @dataclass
@@ -38,6 +63,7 @@ class SmoothedSolve:
     iterations: int
     elapsed: float
     history: list[IterationRecord] = field(default_factory=list)
+    stages: list[ContinuationStage] = field(default_factory=list)
 
 
 def solve_yarn_strain(
@@ -51,6 +77,8 @@ def solve_yarn_strain(
     warp_direction: Sequence[float] | None = None,
     initial_guess: np.ndarray | None = None,
     options: SolveOptions | None = None,
+    continuation: Sequence[float] = (),
+    align_up_to: float | None = None,
 ) -> SmoothedSolve:
     """The cutting pattern of ``mesh`` with the yarn strains treated as ``yarn_strain`` says
     (``"element"`` is the formulation :func:`vares.solve` uses) and ``yarn_stabilisation`` the
@@ -61,15 +89,56 @@ def solve_yarn_strain(
     :func:`vares.geometry.drape.kinematic_drape`); ``prestress`` as for :func:`vares.solve`;
     with ``warp_direction`` (a 3D direction) the yarns are turned until the mean erected warp
     follows it.
+
+    ``continuation``: yarn-to-shear ratios ``E/G`` (ascending, below the law's own,
+    :func:`yarn_to_shear_ratio`) solved first, the law's yarn part scaled to each
+    (:class:`ScaledYarns`), each stage from the last pattern, the law itself last (e.g.
+    ``(1e2, 1e4)`` for a law of E/G = 1e6). Each stage keeps the per-cell yarn stiffness
+    ``yarn_stabilisation × E`` of the law (its share ``yarn_stabilisation × E/E_stage``, at most
+    0.5). With ``warp_direction`` the warp is aligned at the stages of ratio up to
+    ``align_up_to`` (default: every stage); the later ones hold the rotation and yarn angle of
+    the last aligned pattern. The iterations and seconds returned are the stages' sums; each
+    stage is in ``stages``.
     """
-    options = (options or SolveOptions()).replace(
-        yarn_strain=yarn_strain,
-        yarn_stabilisation=yarn_stabilisation,
-        warp_direction=None if warp_direction is None else tuple(warp_direction),
-    )
-    result = solve(
-        mesh, material, thickness, prestress=prestress, options=options, initial_guess=initial_guess
-    )
+    ratio = yarn_to_shear_ratio(material) if len(continuation) else 0.0
+    ratios = [float(r) for r in continuation]
+    if any(not np.isfinite(r) or r <= 0.0 for r in ratios) or np.any(np.diff(ratios) <= 0.0):
+        raise ValueError(f"continuation must be ascending positive ratios; got {ratios}")
+    if ratios and ratios[-1] >= ratio:
+        raise ValueError(
+            f"continuation ratios must lie below the law's yarn-to-shear ratio {ratio:.3g}; "
+            f"got {ratios[-1]:.3g}"
+        )
+    base = (options or SolveOptions()).replace(yarn_strain=yarn_strain)
+    direction = None if warp_direction is None else tuple(warp_direction)
+    stages: list[ContinuationStage] = []
+    history: list[IterationRecord] = []
+    guess, held_angle = initial_guess, None
+    for stage_ratio in [*ratios, None]:
+        law = material if stage_ratio is None else ScaledYarns(material, stage_ratio / ratio)
+        scale = 1.0 if stage_ratio is None else ratio / stage_ratio
+        share = min(yarn_stabilisation * scale, 0.5) if yarn_stabilisation else 0.0
+        shown = ratio if stage_ratio is None else stage_ratio
+        aligned = direction is not None and (align_up_to is None or shown <= align_up_to)
+        stage_options = base.replace(yarn_stabilisation=share)
+        if aligned:
+            stage_options = stage_options.replace(warp_direction=direction)
+        elif held_angle is not None:
+            stage_options = stage_options.replace(warp_direction=None, warp_angle=held_angle)
+        elif direction is not None:
+            stage_options = stage_options.replace(warp_direction=direction)
+            aligned = True
+        result = solve(
+            mesh, law, thickness, prestress=prestress, options=stage_options, initial_guess=guess
+        )
+        stages.append(
+            ContinuationStage(
+                shown, share, aligned, result.converged, result.iterations, result.elapsed
+            )
+        )
+        history.extend(result.history)
+        guess = result.material_coordinates
+        held_angle = float(np.degrees(np.arctan2(result.fibres.warp[1], result.fibres.warp[0])))
     problem = Problem(
         mesh,
         material,
@@ -77,7 +146,7 @@ def solve_yarn_strain(
         fibres=result.fibres,
         prestress=prestress,
         yarn_strain=yarn_strain,
-        yarn_stabilisation=yarn_stabilisation,
+        yarn_stabilisation=stage_options.yarn_stabilisation,
     )
     return SmoothedSolve(
         result.material_coordinates,
@@ -85,10 +154,26 @@ def solve_yarn_strain(
         problem,
         result.converged,
         result.reason,
-        result.iterations,
-        result.elapsed,
-        result.history,
+        sum(s.iterations for s in stages),
+        sum(s.elapsed for s in stages),
+        history,
+        stages,
     )
+
+
+def blank_extent(
+    coordinates: np.ndarray, fibres: Fibres, angles: Sequence[float] = (0.0, 90.0, 45.0, -45.0)
+) -> np.ndarray:
+    """The extent ``max − min`` of a pattern ``(n, 2)`` along directions at ``angles`` [°] to
+    its warp (0: the warp, 90: the fill, ±45: the diagonals), ``(len(angles),)`` in the
+    pattern's length unit (NaN nodes, where a kinematic net does not reach, left out)."""
+    warp = np.arctan2(fibres.warp[1], fibres.warp[0])
+    out = []
+    for angle in angles:
+        t = warp + np.radians(angle)
+        along = coordinates @ np.array([np.cos(t), np.sin(t)])
+        out.append(float(np.nanmax(along) - np.nanmin(along)))
+    return np.array(out)
 
 
 def cell_shear_angle(

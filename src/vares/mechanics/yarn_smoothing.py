@@ -44,9 +44,10 @@ import scipy.sparse as sp
 
 from ..geometry.elements import ELEMENTS
 from ..geometry.mesh import SurfaceMesh
-from ..materials import Fibres, Hyperelastic, MaterialError
+from ..materials import Fibres, Hyperelastic
 from .assembly import Connectivity
 from .kernels import block_energy, nodal_hessian, projected_hessian
+from .yarn_laws import ShearPart
 
 __all__ = ["PATCH_BLOCK", "YARN_STRAINS", "ShearPart", "YarnSmoothing", "paired_domains"]
 
@@ -56,57 +57,8 @@ YARN_STRAINS = ("element", "smoothed", "paired")
 #: Name of the block of node patches in :attr:`YarnSmoothing.connectivity`.
 PATCH_BLOCK = "yarn_patch"
 
-_FIBRE_INVARIANTS = ("I4", "I6", "I8")
 # d = det J = ½ Jᵀ B J with J flattened as (J00, J01, J10, J11)
 _DET_FORM = np.array([[0, 0, 0, 1], [0, 0, -1, 0], [0, -1, 0, 0], [1, 0, 0, 0]], dtype=float)
-
-
-class ShearPart(Hyperelastic):
-    """``Ψ(I4, I6, I8) − (1 − kept) Ψ(I4, I6, 0)`` of a fibre law: what is left per cell when
-    the share ``1 − kept`` of the yarn part ``Ψ(I4, I6, 0)`` is evaluated with smoothed
-    stretches."""
-
-    invariants = _FIBRE_INVARIANTS
-    requires_orthogonal_fibres = True
-
-    def __init__(self, law: Hyperelastic, kept: float = 0.0) -> None:
-        if tuple(law.invariants) != _FIBRE_INVARIANTS:
-            raise MaterialError(
-                "smoothed yarn strains need a law of the invariants (I4, I6, I8); "
-                f"{type(law).__name__} uses {', '.join(law.invariants)}"
-            )
-        self.law = law
-        self.kept = float(kept)
-        self._removed = 1.0 - self.kept
-
-    @staticmethod
-    def _unsheared(inv: np.ndarray) -> np.ndarray:
-        out = inv.copy()
-        out[..., 2] = 0.0
-        return out
-
-    def psi_invariants(self, inv):
-        unsheared = self.law.psi_invariants(self._unsheared(inv))
-        return self.law.psi_invariants(inv) - self._removed * unsheared
-
-    def dpsi_invariants(self, inv):
-        d0 = self.law.dpsi_invariants(self._unsheared(inv))
-        d0[..., 2] = 0.0
-        return self.law.dpsi_invariants(inv) - self._removed * d0
-
-    def d2psi_invariants(self, inv):
-        d0 = self.law.d2psi_invariants(self._unsheared(inv))
-        d0[..., 2, :] = 0.0
-        d0[..., :, 2] = 0.0
-        return self.law.d2psi_invariants(inv) - self._removed * d0
-
-    @property
-    def stiffness_scale(self) -> float:
-        return self.law.stiffness_scale
-
-    @property
-    def parameters(self) -> dict[str, object]:
-        return {"law": type(self.law).__name__, **self.law.parameters}
 
 
 class YarnSmoothing:
