@@ -5,7 +5,9 @@ the roll, one strip at the bottom, the other turned by 180° (the warp stays alo
 lowered onto it until they are a clearance apart; the columns follow one another along the
 roll, each moved back against the one before until they are a clearance apart. Of the four
 ways to turn the two strips the one with the narrowest column is taken. Nothing in it depends
-on time or chance: the same outlines give the same nest, to the last bit, on every machine.
+on time or chance: the same outlines give the same nest, to the last bit, on every machine;
+outlines are taken on a grid of 1e-9 of the roll's width first, so that patterns that differ
+by round-off give the same nest too.
 """
 
 from __future__ import annotations
@@ -21,8 +23,10 @@ __all__ = ["pair_nest"]
 
 #: Stations along a column where the two strips' edges are compared.
 _STATIONS = 400
-#: Halvings of the step when a column is moved back against the one before.
+#: Halvings of the step when a strip is lowered onto another or a column moved back.
 _BISECTIONS = 30
+#: The outlines are taken on a grid of this fraction of the roll width.
+_GRID = 1e-9
 
 
 def _placed(points: np.ndarray, rotation: float, translation) -> np.ndarray:
@@ -60,10 +64,19 @@ def _column(first: np.ndarray, second: np.ndarray, separation: float, edge: floa
             reach = min(np.ptp(bottom[:, 0]), np.ptp(top[:, 0]))
             stations = np.linspace(0.0, reach, _STATIONS)
             gap = np.max(_profile(bottom, stations, True) - _profile(top, stations, False))
-            lift = gap + separation
             below = Polygon(bottom).buffer(separation)
-            while below.intersects(Polygon(top + np.array([0.0, lift]))):  # between the stations
-                lift += 0.1 * separation
+
+            def overlaps(lift: float, top=top, below=below) -> bool:
+                return below.intersects(Polygon(top + np.array([0.0, lift])))
+
+            lift = gap + separation
+            if overlaps(lift):  # they touch between the stations: up until clear, then back
+                low, step = lift, 0.1 * separation
+                while overlaps(lift):
+                    low, lift, step = lift, lift + step, 2.0 * step
+                for _ in range(_BISECTIONS):
+                    middle = 0.5 * (low + lift)
+                    low, lift = (low, middle) if not overlaps(middle) else (middle, lift)
             height = max(bottom[:, 1].max(), (top[:, 1] + lift).max())
             if best is None or height < best[0]:
                 offsets = [
@@ -90,7 +103,10 @@ def pair_nest(
     started = time.perf_counter()
     clearance = clearance_of(roll_width)
     separation = gap + clearance
-    shapes = [np.asarray(o, dtype=float) for o in outlines]
+    # on a grid of 1e-9 of the roll's width: outlines that differ by round-off (patterns solved
+    # on several threads) make the same decisions, hence the same nest
+    grid = _GRID * roll_width
+    shapes = [np.round(np.asarray(o, dtype=float) / grid) * grid for o in outlines]
     placements: dict[int, NestedPiece] = {}
     placed: list = []
     end = 0.0
