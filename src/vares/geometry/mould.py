@@ -69,10 +69,6 @@ class Mould:
         """The outwardness ``(k,)`` at points given by faces and barycentric coordinates."""
         return np.einsum("kc,kc->k", bary, self.outwardness[self.triangles[faces]])
 
-    def on_part(self, faces: np.ndarray) -> np.ndarray:
-        """``(k,)`` bool: the faces that are the mould's own (not the flange's)."""
-        return np.asarray(faces) < self.part_cells
-
 
 def mould_surface(mesh: SurfaceMesh, flange_width: float = 0.0, layers: int | None = None) -> Mould:
     """The mould ``mesh`` (triangles or quads; quads are split) as a contact surface, extended by
