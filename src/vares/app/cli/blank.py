@@ -143,6 +143,11 @@ def drape_blank(
             folder.discard()
         if not values["quiet"]:
             state = "converged" if result.converged else f"NOT converged ({result.reason})"
+            if result.facet_limited:
+                state = (
+                    f"converged as far as the mould's facets allow (unbalanced force "
+                    f"{100 * summary['unbalanced_force']:.2g} % of the cells' forces)"
+                )
             console.print(
                 f"blank of {len(blank.coordinates)} nodes draped: {state} in "
                 f"{result.iterations} iterations ({result.elapsed:.1f} s); net area "
