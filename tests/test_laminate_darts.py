@@ -3,6 +3,7 @@ laminate's plies draped on a Dask cluster."""
 
 import re
 import tomllib
+from dataclasses import replace
 
 import ezdxf
 import numpy as np
@@ -154,6 +155,25 @@ def test_ply_book_shows_the_darts(darted):
     assert f"{a.max_shear_before:.4g}°" in summary and f"{a.max_shear_after:.4g}°" in summary
     assert "below the locking angle" in summary
     assert "No darts needed" in re.search(r"<p id='darts-B'>(.*?)</p>", text, re.S).group(1)
+
+
+def test_darts_that_do_not_lower_the_shear_are_reported_and_not_cut(darted):
+    """Darts whose solve leaves the largest shear as high (the rib's, docs/composites.md): the
+    ply is cut whole, and the book says the darts were tried."""
+    a = darted.drape("A")
+    worse = replace(
+        a.darted,
+        rounds=[replace(r, max_shear=a.darted.max_shear_before + 0.1) for r in a.darted.rounds],
+    )
+    tried = replace(a, darted=worse)
+    assert not tried.is_darted and tried.blank_mesh is tried.mesh
+    assert tried.blank_pattern is tried.pattern
+    result = replace(darted, drapes=[tried, darted.drape("B")])
+    blanks = ply_blanks(result)
+    assert not blanks[0].darts and blanks[0].mesh is a.mesh
+    text = ply_book(result, blanks, None, units="mm")
+    said = re.search(r"<p id='darts-A'>(.*?)</p>", text, re.S).group(1)
+    assert f"Darts tried and not cut: {len(a.darted.dart_lines)} dart(s)" in said
 
 
 def test_given_dart_lines_are_opened_as_given(darted, tmp_path):

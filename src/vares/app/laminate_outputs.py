@@ -225,6 +225,8 @@ def _matrix_lines(result: LaminateResult, value: str) -> list[str]:
 def _darts_cell(drape: PlyDrapeResult) -> str:
     if drape.darted is None:
         return "–"
+    if drape.darted.after is not None and not drape.is_darted:
+        return f"not cut: {len(drape.darted.dart_lines)} tried, no lower"
     if not drape.is_darted:
         return "none needed" if drape.darted.relieved else "none placed"
     return f"{len(drape.darted.dart_lines)} ({drape.darted.max_shear_after:.2f}°)"

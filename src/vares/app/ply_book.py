@@ -281,6 +281,18 @@ def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: 
     after; or, without darts, how much of the ply is at or beyond the locking angle."""
     limit = 100 * check.fractions["limit"]
     darted = drape.darted
+    if darted is not None and darted.after is not None and not drape.is_darted:
+        lengths = ", ".join(number(v, 4) for v in darted.summary()["dart_lengths"])
+        after = "did not converge" if not darted.after.converged else (
+            f"{number(darted.max_shear_after, 4)}° with them open"
+        )  # fmt: skip
+        text = (
+            f"Darts tried and not cut: {len(darted.dart_lines)} dart(s) ({lengths} {units} on "
+            f"the mould), the largest shear {number(darted.max_shear_before, 4)}° without them, "
+            f"{after}: they do not lower it, so the ply is cut whole. {limit:.1f} % of the "
+            "ply's area is at or beyond the locking angle."
+        )
+        return [f"<p id='darts-{ident}'>{html.escape(text)}</p>"]
     if darted is None or darted.after is None:
         if darted is None:
             why = "No darts (none asked for: darts = 'auto' or dart_lines)."

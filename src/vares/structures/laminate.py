@@ -24,7 +24,6 @@ How the plies are run (here, in local processes, on a Dask scheduler) is :mod:`.
 
 from __future__ import annotations
 
-import hashlib
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -42,7 +41,14 @@ from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
 from .laminate_pairs import PAIR_VALUES, PairCheck, blank_used_for, draped_yarns, pair_check
 from .laminate_regions import cell_blocks, ply_warp, region_cells, submesh
-from .laminate_tasks import dart_task, drape_tasks, on_mould_cells, ply_locking_angle
+from .laminate_tasks import (
+    dart_task,
+    darts_used,
+    drape_key,
+    drape_tasks,
+    on_mould_cells,
+    ply_locking_angle,
+)
 
 __all__ = [
     "PAIR_VALUES",
@@ -112,7 +118,8 @@ class PlyDrapeResult:
     the warp there. ``pattern``: the mechanical drape (:func:`vares.solve`, warp along +x);
     ``kinematic``: the pin-jointed net beside it (``None`` when not asked for or failed, with
     ``kinematic_error``). ``darted``: the ply with its darts open (``None`` without darts asked
-    for; its ``after`` is ``None`` when none was needed or placed) and ``locking_angle`` (degrees).
+    for; its ``after`` is ``None`` when none was needed or placed; the ply is cut with them when
+    :attr:`is_darted`) and ``locking_angle`` (degrees).
     Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``, ``fill`` (unit erected
     yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
     laid (the darted pattern's, each mould cell the area-weighted mean of its pieces in the
@@ -146,8 +153,9 @@ class PlyDrapeResult:
 
     @property
     def is_darted(self) -> bool:
-        """Whether the ply was cut open along darts (asked for, and placed)."""
-        return self.darted is not None and self.darted.after is not None
+        """Whether the ply is cut open along darts: asked for, placed, and lowering its largest
+        shear (:func:`~vares.structures.laminate_tasks.darts_used`)."""
+        return darts_used(self.darted)
 
     @property
     def blank_mesh(self) -> SurfaceMesh:
@@ -272,23 +280,6 @@ def _label(orientation: float, taken: Sequence[str]) -> str:
     return label
 
 
-def _key(ply: Ply, seed: np.ndarray, cells: np.ndarray, darts: dict | None) -> tuple:
-    o = ply.options
-    if darts is not None and darts["polylines"] is not None:
-        digest = hashlib.sha1(
-            b"".join(np.ascontiguousarray(p).tobytes() for p in darts["polylines"])
-        )
-        darts = {**darts, "polylines": digest.hexdigest()}
-    return (
-        None if darts is None else tuple(sorted(darts.items())),
-        round(float(o.orientation) % 360.0, 9),
-        repr(ply.material.parameters) + type(ply.material).__name__,
-        tuple(np.round(seed, 12)),
-        o.fabric_kind,
-        cells.tobytes(),
-    )
-
-
 @takes_options(LaminateOptions)
 def drape_laminate(
     mesh: SurfaceMesh,
@@ -338,7 +329,7 @@ def drape_laminate(
             seed = default_seed
         sub, nodes = submesh(mesh, cells)
         darts = dart_task(ply, options, sub)
-        key = _key(ply, seed, cells, darts)
+        key = drape_key(ply, seed, cells, darts)
         ply_drape[o.name] = key
         if key in groups:
             groups[key]["plies"].append(o.name)
@@ -411,7 +402,7 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
 
     darted: DartedPattern | None = outcome["darted"]
     shear = pattern.fields["shear_angle"]
-    if darted is not None and darted.after is not None:  # the ply as laid: opened, read back
+    if darts_used(darted):  # the ply as laid: opened, read back
         opened, laid = darted.slits.mesh, darted.after
         warp, fill = draped_yarns(
             opened, laid.material_coordinates, laid.fibres.warp, laid.fibres.fill

@@ -9,12 +9,16 @@ the mesh cut open along the darts. Cutting the mesh makes the dart lines' points
 cells a dart crosses are split, and every node of a dart but its tip gets a twin: the opened mesh
 has more cells than the ply's. Each of its cells lies in one cell of the ply's mesh
 (:attr:`~vares.geometry.slits.SlitMesh.cell_origin`); a cell no dart crosses is that very
-triangle. :func:`on_mould_cells` gives every cell of the ply's mesh the area-weighted mean of its
-pieces (unit vectors normalised again), which is the piece's own value where the cell is whole.
+triangle. A ply is cut with its darts only when they lower its largest shear
+(:func:`darts_used`): darts that leave it as high or higher (the rib's, docs/composites.md) are
+reported, and the ply is cut whole. :func:`on_mould_cells` gives every cell of the ply's mesh
+the area-weighted mean of its pieces (unit vectors normalised again), which is the piece's own
+value where the cell is whole.
 """
 
 from __future__ import annotations
 
+import hashlib
 import threading
 import time
 from collections.abc import Sequence
@@ -22,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..analysis.darts import solve_with_darts
+from ..analysis.darts import DartedPattern, solve_with_darts
 from ..analysis.drape import drape_ply
 from ..geometry.mesh import SurfaceMesh
 from ..materials.forming import locking_angle
@@ -42,6 +46,8 @@ SOLVE_LOCK = threading.Lock()
 __all__ = [
     "SOLVE_LOCK",
     "dart_task",
+    "darts_used",
+    "drape_key",
     "drape_task",
     "drape_tasks",
     "on_mould_cells",
@@ -90,6 +96,14 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
         "error": error,
         "seconds": time.perf_counter() - started,
     }
+
+
+def darts_used(darted: DartedPattern | None) -> bool:
+    """Whether a ply is cut with the darts of ``darted``: some were opened, the solve with them
+    converged, and they lower the ply's largest shear."""
+    if darted is None or darted.after is None or not darted.after.converged:
+        return False
+    return bool(darted.max_shear_after < darted.max_shear_before)
 
 
 def drape_tasks(
@@ -156,3 +170,23 @@ def dart_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str
         "mode": "none" if lines is not None else mode,
         "polylines": lines,
     }
+
+
+def drape_key(ply: Ply, seed: np.ndarray, cells: np.ndarray, darts: dict | None) -> tuple:
+    """What makes two plies one drape: orientation, material, seed, fabric kind, locking
+    angle, cells and darts (the plies of a symmetric stack's halves share it)."""
+    o = ply.options
+    if darts is not None and darts["polylines"] is not None:
+        digest = hashlib.sha1(
+            b"".join(np.ascontiguousarray(p).tobytes() for p in darts["polylines"])
+        )
+        darts = {**darts, "polylines": digest.hexdigest()}
+    return (
+        None if darts is None else tuple(sorted(darts.items())),
+        round(float(o.orientation) % 360.0, 9),
+        repr(ply.material.parameters) + type(ply.material).__name__,
+        tuple(np.round(seed, 12)),
+        o.fabric_kind,
+        o.locking_angle,
+        cells.tobytes(),
+    )
