@@ -25,7 +25,7 @@ from ..materials.fitting import FabricFit
 from .fabric_band import FabricBand
 from .html_parts import figure, number, page, report_drawing, table
 
-__all__ = ["band_report", "fit_report"]
+__all__ = ["band_report", "band_section", "fit_report"]
 
 
 def _record(records: list[BiaxialRecord], name: str, source: str) -> BiaxialRecord | None:
@@ -144,9 +144,20 @@ def fit_report(fitted: FabricFit, records: list[BiaxialRecord]) -> str:
 
 def band_report(band: FabricBand, units: str = "m") -> str:
     """The band's report (one HTML page, the figure embedded)."""
-    scatter = band.options
     parts = page(band.fabric.name, f"Pattern band: {band.fabric.name}", "converged", [])
-    parts.append("<h2>Fabric and samples</h2>")
+    with report_drawing():
+        parts += band_section(band, units)
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def band_section(band: FabricBand, units: str = "m", level: int = 2) -> list[str]:
+    """The band as parts of an HTML page: the fabric and its samples, every figure's band, the
+    figure of the pattern dimensions with their band (drawn: call it inside
+    :func:`~vares.app.html_parts.report_drawing`). ``level``: of the section headings."""
+    scatter = band.options
+    h = f"h{level}"
+    parts = [f"<{h}>Fabric and samples</{h}>"]
     parts.append(f"<p>{html.escape(band.fabric.name)} ({html.escape(band.fabric.source)}): ")
     c, s = band.fabric.compensation, band.constants
     if scatter.sampled == "constants" and s is not None:
@@ -177,7 +188,7 @@ def band_report(band: FabricBand, units: str = "m") -> str:
         )
         for name, d in band.band.to_dict().items()
     ]
-    parts.append("<h2>Band</h2>")
+    parts.append(f"<{h}>Band</{h}>")
     parts.append(
         table(
             rows,
@@ -185,14 +196,12 @@ def band_report(band: FabricBand, units: str = "m") -> str:
             "band",
         )
     )
-    with report_drawing():
-        parts.append(
-            figure(band_plot(band.band, units), "pattern dimensions with their band", "band-plot")
-        )
+    parts.append(
+        figure(band_plot(band.band, units), "pattern dimensions with their band", "band-plot")
+    )
     seconds = band.seconds
     parts.append(
         f"<p>Nominal case {seconds.get('nominal', 0):.2f} s; {scatter.samples} samples "
         f"{seconds.get('samples', 0):.2f} s.</p>"
     )
-    parts.append("</body></html>")
-    return "\n".join(parts)
+    return parts

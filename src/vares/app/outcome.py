@@ -20,6 +20,7 @@ from .sections import STRUCTURE_MARK_SPACING
 if TYPE_CHECKING:  # made (and their modules imported) only when a job asks for them
     from ..analysis.drape import PlyDrape
     from ..analysis.erection_optimum import OptimisedPatterns
+    from .run_band import RunBand
 
 __all__ = ["JobOutcome", "PanelOutcome"]
 
@@ -47,7 +48,8 @@ class JobOutcome:
     the structure's result for a structure (and the cut's for a cut job), the erection (when
     asked for; of the optimised patterns with ``[erection] optimise``, ``optimum`` holding the
     optimisation and the VaReS patterns' erection), the output folder, the length units, what
-    the input's repair changed, and every file written."""
+    the input's repair changed, the band of the patterns under the fabric's scatter (with
+    ``[scatter]``) and every file written."""
 
     job: Job
     material: Hyperelastic
@@ -59,6 +61,7 @@ class JobOutcome:
     cut: CutResult | None = None
     erection: ErectionResult | None = None
     optimum: OptimisedPatterns | None = None
+    scatter: RunBand | None = None
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 

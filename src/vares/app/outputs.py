@@ -6,7 +6,9 @@ One pattern (in the output directory; for a structure, in a folder per panel):
 ``pattern.dxf``                 cutter drawing (seam, cut line, warp, marks, label)
 ``pattern.svg``, ``pattern.png`` the pattern drawn with its warp and fill directions
 ``pattern.vtu``, ``surface.vtu`` pattern and surface with every per-cell result (ParaView)
-``summary.json``                the key figures, the compensation report and the history
+``summary.json``                the key figures, the compensation report and the history (and
+                                with ``[scatter]`` the band of the pattern under the fabric's
+                                scatter, key ``scatter``: :mod:`vares.app.run_band`)
 ``pattern_FIELD.svg/.png``, ``surface_FIELD.png``   the fields asked for with ``plots``
 ``surface.obj``                 the 3D surface, for examples and for a structure's panels
 ``report.html``                 with ``report``: everything above for a person, in one file
@@ -16,7 +18,8 @@ it), from which ``vares erect DIR`` (and ``vares run DIR/job.toml -o …``) take
 material, fibres and prestress; an erection writes ``erect/`` (:mod:`vares.app.erection_outputs`).
 
 A structure adds ``structure.json`` (panels, seams before and after matching, the energy price,
-the roll width check), ``structure.dxf`` (all patterns with matching marks) and, with ``report``,
+the roll width check; with ``[scatter]`` the band of every panel and seam, key ``scatter``),
+``structure.dxf`` (all patterns with matching marks) and, with ``report``,
 its own ``report.html``. A cut job writes its pieces nested on the roll instead of
 ``structure.dxf``, and the files of :mod:`vares.app.cut_outputs`. Every target is checked
 before the solve (nothing is overwritten without ``force``); every file is written atomically.
@@ -179,6 +182,8 @@ def write_panel(panel: PanelOutcome, outcome: JobOutcome, marks: np.ndarray | No
         )
     if job.structure is None and outcome.erection is not None:
         data["erection"] = erection_figures(outcome.erection, outcome.units, outcome.optimum)
+    if job.structure is None and outcome.scatter is not None:
+        data["scatter"] = outcome.scatter.to_dict(outcome.units)
     _write(panel, "summary.json", lambda p: write_json(p, data))
 
 
@@ -335,6 +340,8 @@ def write_structure(outcome: JobOutcome, marks: list[np.ndarray] | None) -> None
         data["cutting"] = cutting_details(outcome)
     if outcome.erection is not None:
         data["erection"] = erection_figures(outcome.erection, outcome.units, outcome.optimum)
+    if outcome.scatter is not None:
+        data["scatter"] = outcome.scatter.to_dict(outcome.units)
     write_json(directory / "structure.json", data)
     outcome.files.append(directory / "structure.json")
 

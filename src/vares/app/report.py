@@ -6,7 +6,8 @@ directions, the result fields on the pattern and on the 3D surface, the key figu
 warnings. A structure gets one more, for the whole: its panels, its seams before and after
 matching, and links to the panels' reports. A job that erects its structure adds the erection
 section (:mod:`vares.app.erection_report`) to the pattern's report (the structure's, for a
-structure); one that drapes a ply, the drape's (:mod:`vares.app.drape_report`).
+structure); one that drapes a ply, the drape's (:mod:`vares.app.drape_report`); one with
+``[scatter]``, the band of its patterns under the fabric's scatter (:mod:`vares.app.run_band`).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from .job import Job
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import units_of
 
-__all__ = ["html_report", "structure_report", "write_reports"]
+__all__ = ["html_report", "scatter_section", "structure_report", "write_reports"]
 
 _FIGURE_FIELDS = ("det_F", "warp_stress", "fill_stress", "shear_angle", "stress_min")
 
@@ -260,6 +261,8 @@ def html_report(panel: PanelOutcome, outcome: JobOutcome) -> str:
         parts += erection_section(
             outcome.erection, outcome.units, outcome.directory / "erect", outcome.optimum
         )
+    if outcome.structure is None:
+        parts += scatter_section(outcome)
     files = [(f.name, os.path.relpath(f, panel.directory)) for f in panel.files]
     parts += [
         "<h2>Files</h2>",
@@ -333,9 +336,29 @@ def structure_report(outcome: JobOutcome) -> str:
             if outcome.erection is not None
             else []
         ),
+        *scatter_section(outcome),
         "</body></html>",
     ]
     return "\n".join(parts)
+
+
+def scatter_section(outcome: JobOutcome) -> list[str]:
+    """The band of the run's patterns under the fabric's scatter (none without ``[scatter]``):
+    the fabric and its samples, the band of every figure and its plot, or why there is none."""
+    if outcome.scatter is None:
+        return []
+    from .fabric_report import band_section
+
+    run = outcome.scatter
+    parts = [f"<h2>Fabric scatter: the band of the patterns ({html.escape(str(run.path))})</h2>"]
+    if run.band is None:
+        return [*parts, f"<p>No band: {html.escape(run.reason or '')}</p>"]
+    parts.append(
+        "<p>The nominal case is the run's own patterns solved again with the same law and "
+        f"options (its figures differ from the run's by at most {run.nominal_difference:.1e} "
+        f"{html.escape(outcome.units)}); the samples were solved in this process.</p>"
+    )
+    return parts + band_section(run.band, outcome.units, level=3)
 
 
 def _cut_section(outcome: JobOutcome) -> list[str]:

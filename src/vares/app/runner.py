@@ -42,6 +42,7 @@ from .outputs import (
     write_panel,
     write_structure,
 )
+from .run_band import check_run_band, run_band
 from .staging import OutputFolder, add_to_manifest, listed
 
 __all__ = ["ErectionRun", "run_erection", "run_job"]
@@ -65,6 +66,7 @@ def run_job(
     if job.drape is not None and job.structure is not None:
         raise JobError("[drape] drapes a ply on a single surface, not on a structure's panels")
     material = job.material.build(job.base)
+    band_inputs = check_run_band(job)
     source = load_input(job)
     check_mark_spacing(job, source)
     folder = OutputFolder(
@@ -89,6 +91,11 @@ def run_job(
         if job.erection is not None:
             _erect(outcome, _options(job), callback)
     outcome.warnings = source.warnings + [str(w.message) for w in caught] + outcome.warnings
+    if band_inputs is not None:
+        if outcome.patterned:
+            outcome.scatter = run_band(outcome, band_inputs, _options(job))
+        else:
+            outcome.warnings.append("no scatter band: the patterns did not converge")
     root = folder.start()
     try:
         _write(outcome, root, save_job, folder)

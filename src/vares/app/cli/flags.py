@@ -18,6 +18,7 @@ import typer
 
 from ...analysis.drape_options import DrapeOptions
 from ...analysis.options import ErectionOptions
+from ...analysis.scatter_options import ScatterOptions
 from ...options import Options, OptionsError, Spec
 from ...solver.options import SolveOptions
 from ...structures.options import CutOptions, StructureOptions
@@ -27,6 +28,8 @@ from ..sections import InputOptions, MaterialOptions, OutputOptions, PrestressOp
 __all__ = [
     "ERECTION_FLAGS",
     "ERECT_FLAG",
+    "SCATTER_FLAG",
+    "SCATTER_FLAGS",
     "InputError",
     "build",
     "erection_from_flags",
@@ -35,6 +38,7 @@ __all__ = [
     "job_from_flags",
     "numbers",
     "option_parameter",
+    "scatter_from_flags",
     "with_flags",
 ]
 
@@ -50,6 +54,7 @@ PANELS = {
     "erection": "Erection",
     "cut": "Cutting and nesting",
     "drape": "Drape and producibility",
+    "scatter": "Fabric scatter",
 }
 #: Kinds given on the command line as one comma-separated string.
 _TEXT_KINDS = {"vector", "plane", "floats", "strings", "paths"}
@@ -69,11 +74,12 @@ def option_parameter(
     )
 
 
-def flag_name(name: str, spec: Spec) -> str:
-    """The (first) command-line name of an option."""
+def flag_name(name: str, spec: Spec, prefix: str = "") -> str:
+    """The (first) command-line name of an option (``prefix``: before the option's own name,
+    as ``--scatter-samples`` for ``samples``)."""
     if spec.flags:
         return spec.flags[0].split("/")[0]
-    return "--" + name.replace("_", "-")
+    return "--" + (prefix + name).replace("_", "-")
 
 
 def _enum(name: str, choices: tuple[str, ...]) -> type[StrEnum]:
@@ -81,17 +87,23 @@ def _enum(name: str, choices: tuple[str, ...]) -> type[StrEnum]:
 
 
 def flags(
-    cls: type[Options], *, exclude: Iterable[str] = (), defaults: dict[str, Any] | None = None
+    cls: type[Options],
+    *,
+    exclude: Iterable[str] = (),
+    defaults: dict[str, Any] | None = None,
+    prefix: str = "",
 ) -> list[inspect.Parameter]:
     """One parameter per option of ``cls`` that has a flag (``Spec.flags != ()``).
 
-    ``defaults`` replaces an option's shown default (e.g. another output folder)."""
+    ``defaults`` replaces an option's shown default (e.g. another output folder); ``prefix``
+    goes before every parameter's and flag's name (``scatter_`` makes ``samples``
+    ``--scatter-samples``), for options whose names other flags of the command have."""
     out = []
     for name, spec in cls.specs().items():
         if spec.flags == () or name in exclude:
             continue
         default = (defaults or {}).get(name, cls.defaults()[name])
-        names = spec.flags or (flag_name(name, spec),)
+        names = spec.flags or (flag_name(name, spec, prefix),)
         help_text = spec.help
         extra: dict[str, Any] = {}
         if spec.kind in _TEXT_KINDS:
@@ -113,7 +125,13 @@ def flags(
                 help_text += f" ({spec.bounds()})"
         out.append(
             option_parameter(
-                name, default, kind, *names, help=help_text, panel=PANELS[spec.section], **extra
+                prefix + name,
+                default,
+                kind,
+                *names,
+                help=help_text,
+                panel=PANELS[spec.section],
+                **extra,
             )
         )
     return out
@@ -158,15 +176,15 @@ def _parse(name: str, spec: Spec, text: str) -> Any:
     return text
 
 
-def build(cls: type[Options], values: dict[str, Any], **fixed: Any) -> Options:
-    """The options object the flag ``values`` describe (plus ``fixed`` settings); a refused
-    value is an :class:`InputError` naming its flag."""
+def build(cls: type[Options], values: dict[str, Any], prefix: str = "", **fixed: Any) -> Options:
+    """The options object the flag ``values`` describe (plus ``fixed`` settings; ``prefix``: that
+    of :func:`flags`); a refused value is an :class:`InputError` naming its flag."""
     specs = cls.specs()
     settings: dict[str, Any] = {}
     for name, spec in specs.items():
-        if name not in values or values[name] is None:
+        value = values.get(prefix + name)
+        if value is None:
             continue
-        value = values[name]
         if spec.kind in _TEXT_KINDS:
             value = _parse(name, spec, value)
         elif isinstance(value, StrEnum):
@@ -180,7 +198,7 @@ def build(cls: type[Options], values: dict[str, Any], **fixed: Any) -> Options:
     except OptionsError as exc:
         if exc.key is None or exc.key not in specs:
             raise InputError(exc.problem) from None
-        raise InputError(f"{flag_name(exc.key, specs[exc.key])} {exc.problem}") from None
+        raise InputError(f"{flag_name(exc.key, specs[exc.key], prefix)} {exc.problem}") from None
 
 
 #: The composite prestress flags (they set several options of :class:`PrestressOptions`).
@@ -263,6 +281,37 @@ def drape_from_flags(values: dict[str, Any], *, drape: bool) -> DrapeOptions | N
     return None
 
 
+#: ``--scatter``: carry the fabric file's scatter into the patterns.
+SCATTER_FLAG = [
+    option_parameter(
+        "scatter",
+        False,
+        bool,
+        "--scatter",
+        help="Pattern again at random samples of the fabric file's compensation values (or "
+        "constants) and write the band of every pattern dimension, seam length and the erected "
+        "prestress into summary.json / structure.json (and report.html); needs a fabric file "
+        "with scatter (docs/fabrics.md).",
+        panel=PANELS["scatter"],
+    )
+]
+#: The scatter options' flags, ``--scatter-samples`` and the like.
+SCATTER_FLAGS = flags(ScatterOptions, prefix="scatter_")
+
+
+def scatter_from_flags(values: dict[str, Any], *, scatter: bool) -> ScatterOptions | None:
+    """The scatter options the flags describe, or None without ``scatter``; a scatter flag
+    given without it is an error."""
+    options = build(ScatterOptions, values, prefix="scatter_")
+    if scatter:
+        return options
+    changed = [n for n, d in ScatterOptions.defaults().items() if getattr(options, n) != d]
+    if changed:
+        flag = flag_name(changed[0], ScatterOptions.specs()[changed[0]], "scatter_")
+        raise InputError(f"{flag} is a scatter option: add --scatter")
+    return None
+
+
 def _prestress(values: dict[str, Any]) -> dict[str, Any]:
     given, field = values.get("prestress"), values.get("prestress_field")
     if given is not None and field is not None:
@@ -278,7 +327,7 @@ def _prestress(values: dict[str, Any]) -> dict[str, Any]:
     return {}
 
 
-#: The flags of a patterning job (pattern, example, panels).
+#: The flags of a patterning job (pattern, example, panels, cut).
 JOB_FLAGS = (
     flags(MaterialOptions)
     + flags(SolveOptions)
@@ -287,6 +336,8 @@ JOB_FLAGS = (
     + flags(OutputOptions)
     + ERECT_FLAG
     + ERECTION_FLAGS
+    + SCATTER_FLAG
+    + SCATTER_FLAGS
 )
 
 
@@ -336,5 +387,6 @@ def job_from_flags(
         structure=build(StructureOptions, values) if structure else None,
         erection=erection_from_flags(values, erect=values.get("erect", False)),
         drape=drape_from_flags(values, drape=values.get("drape", False)),
+        scatter=scatter_from_flags(values, scatter=values.get("scatter", False)),
         base=Path.cwd(),
     )

@@ -1,0 +1,192 @@
+"""The band of a run's own patterns under the scatter of its fabric file: the ``[scatter]`` table
+of a job, ``--scatter`` on ``vares pattern``, ``example``, ``panels`` and ``cut``.
+
+:func:`check_run_band` refuses, before the solve, a job whose band could not be the band of its
+own patterns: no fabric file, a file without the scatter of what is sampled, a run compensated
+otherwise than the samples are, a prestress that is not one uniform value, patterns optimised
+for the erected state. :func:`run_band` then patterns the run's panels (one surface, a
+structure's panels, or a cut job's strips, each with the warp it was solved with) by
+:func:`vares.app.fabric_band.fabric_band` with the job's solver, structure and erection options:
+the nominal case again, and every sample. The samples are solved in this process (a job holds no
+worker settings; ``vares batch`` runs whole jobs in parallel). The nominal case is the run's own
+pattern solved again with the same law, prestress and options; ``nominal_difference`` records
+how far its figures are from the run's (0 to round-off).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..analysis.scatter import pattern_dimensions
+from ..materials.base import MaterialError
+from ..materials.fabric_file import ConstantScatter, constant_scatter
+from ..materials.presets import FabricPreset, fabric, file_fabric
+from ..solver.options import SolveOptions
+from ..structures.panels import Panel
+from .fabric_band import FabricBand, fabric_band, structure_figures
+from .job import Job, JobError
+from .outcome import JobOutcome
+
+__all__ = ["BandInputs", "RunBand", "check_run_band", "run_band"]
+
+#: How a refusal starts: the flag and the job-file table that asked for the band.
+ASKED = "--scatter ([scatter])"
+
+
+@dataclass(frozen=True)
+class BandInputs:
+    """What a run's band is computed from: the fabric file, its fabric, the constants' scatter
+    (sampling the constants), the run's uniform prestress (warp, fill[, shear]) and what the
+    run is to be warned of (a scatter of 0)."""
+
+    path: Path
+    fabric: FabricPreset
+    constants: ConstantScatter | None
+    prestress: tuple[float, ...]
+    notes: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class RunBand:
+    """The band of a run (:func:`run_band`), or why there is none (``reason``)."""
+
+    path: Path
+    band: FabricBand | None
+    reason: str | None = None
+    nominal_difference: float | None = None
+
+    def to_dict(self, units: str) -> dict[str, Any]:
+        """The ``scatter`` section of ``summary.json`` / ``structure.json``."""
+        head: dict[str, Any] = {"fabric_file": str(self.path)}
+        if self.band is None:
+            return head | {"converged": False, "reason": self.reason}
+        return (
+            head
+            | self.band.to_dict()
+            | {
+                "units": units,
+                "nominal_case": "the run's own patterns solved again with the same law and options",
+                "nominal_difference": self.nominal_difference,
+                "where": "in this process",
+            }
+        )
+
+
+def check_run_band(job: Job) -> BandInputs | None:
+    """The inputs of the job's band (None without ``[scatter]``); a :class:`JobError` names the
+    fabric file when the band cannot be the band of the run's own patterns."""
+    options = job.scatter
+    if options is None:
+        return None
+    material = job.material
+    if material.presets is None:
+        given = material.fabric or material.law or "the default law"
+        raise JobError(
+            f"{ASKED} needs a fabric file with scatter (--fabric FILE.toml, from 'vares fabric "
+            f"fit'); the material is {given}"
+        )
+    path = job.path(material.presets)
+    try:
+        preset = file_fabric(path) if material.fabric is None else fabric(material.fabric, path)
+    except MaterialError as exc:
+        raise JobError(f"{ASKED}: {exc}") from None
+    by = material.compensate_by or preset.compensate_by
+    constants = None
+    if options.sampled == "compensation":
+        if by != "measured":
+            raise JobError(
+                f"{ASKED}: {path}: the run compensates by the fitted law; its band samples the "
+                "constants: add --scatter-sampled constants ([scatter] sampled = 'constants')"
+            )
+        c = preset.compensation
+        if c is None:
+            raise JobError(
+                f"{ASKED} needs a fabric file with scatter: {path}: fabric {preset.name!r} has "
+                "no measured compensation values"
+            )
+        scatter = (c.specimens, c.warp_std, c.fill_std)
+    else:
+        if by != "law":
+            raise JobError(
+                f"{ASKED}: {path}: sampling the constants is the band of a pattern compensated "
+                "by the fitted law; the run compensates by the measured values: add "
+                "--compensate-by law, or sample the compensation values"
+            )
+        constants = constant_scatter(path, preset.name)
+        if constants is None:
+            raise JobError(
+                f"{ASKED} needs a fabric file with scatter: {path}: fabric {preset.name!r} has "
+                "no scatter of its constants (no [scatter] table)"
+            )
+        scatter = (constants.specimens, constants.E1, constants.E2, constants.nu12)
+    what = "compensation values" if constants is None else "constants"
+    if scatter[0] == 1:
+        raise JobError(
+            f"{ASKED} needs a fabric file with scatter: {path}: its {what} come from one "
+            "specimen, their scatter is unknown (written as 0); fit two or more records"
+        )
+    notes = ()
+    if not any(scatter[1:]):
+        notes = (
+            f"the scatter of the {what} in {path} is 0: every sample is the nominal pattern "
+            "and every spread is 0",
+        )
+    prestress = job.prestress
+    if prestress.field is not None or prestress.warp is None:
+        measured = preset.compensation
+        at = "" if measured is None else f"; the fabric was measured at {measured.prestress}"
+        raise JobError(
+            f"{ASKED} needs one uniform prestress (--prestress WARP,FILL){at}; got "
+            + ("a per-cell field" if prestress.field is not None else "none")
+        )
+    if job.erection is not None and job.erection.optimise:
+        raise JobError(
+            f"{ASKED} gives the band of the VaReS patterns; with --optimise the run cuts "
+            "patterns optimised for the erected state: leave one of them out"
+        )
+    load = tuple(float(v) for v in prestress.value({}))
+    return BandInputs(path, preset, constants, load, notes)
+
+
+def run_band(outcome: JobOutcome, inputs: BandInputs, options: SolveOptions) -> RunBand:
+    """The band of a run's patterns (module docs); a case that does not converge gives a band
+    with its ``reason`` instead (and a warning in the outcome)."""
+    job = outcome.job
+    outcome.warnings.extend(inputs.notes)
+    settings: dict[str, Any] = {"options": options}
+    structure = outcome.structure
+    if structure is None:
+        panels = [Panel(p.name, p.mesh) for p in outcome.panels]
+    else:
+        panels = list(structure.panels)
+        settings["structure"] = structure.structure_options
+        if outcome.cut is not None and options.warp_direction is None:  # each strip's own warp
+            settings["panel_settings"] = [
+                {"warp_direction": tuple(r.options.warp_direction)} for r in structure.results
+            ]
+    try:
+        with warnings.catch_warnings():  # the run has said it of its own patterns
+            warnings.simplefilter("ignore")
+            band = fabric_band(
+                panels,
+                inputs.fabric,
+                job.material.thickness,
+                inputs.prestress,
+                scatter=job.scatter,
+                constants=inputs.constants,
+                erection=job.erection,
+                **settings,
+            )
+    except MaterialError as exc:
+        outcome.warnings.append(f"no scatter band: {exc}")
+        return RunBand(inputs.path, None, str(exc))
+    own = (
+        pattern_dimensions(outcome.panels[0].result)
+        if structure is None
+        else structure_figures(structure)
+    )
+    difference = max(abs(band.band.nominal[name] - value) for name, value in own.items())
+    return RunBand(inputs.path, band, None, float(difference))
