@@ -5,15 +5,21 @@ the beginning of the pseudo-time path. Where the surface is steep to the plane t
 distorts or folds cells; the least-squares conformal map (LSCM) is then the better start. Both
 can fold on rough or strongly curved meshes; Tutte's embedding never folds a disk, and the
 automatic choice falls back to it.
+
+Where the energy does not depend on the pattern's rotation (an isotropic law without prestress),
+the automatic start is then taken one as-rigid-as-possible step further (:func:`arap_refined`):
+on a rough scan the projection is far from the optimum cell by cell (7 Newton iterations on
+the 20k-triangle scan-like example), one ARAP step is near it (3), and the optimum is the same.
 """
 
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..geometry.arap import ArapFlattening
 from ..geometry.flatten import (
     ProjectionPlane,
     inverted_cells,
@@ -24,10 +30,12 @@ from ..geometry.flatten import (
     untangle,
 )
 from ..geometry.mesh import SurfaceMesh
+from ..mechanics.rigid import rigid_modes
 from ..options import OptionsError
+from .linear import LinearSolver, get_solver
 from .options import SolveOptions
 
-__all__ = ["PROJECTION_MIN_AREA_RATIO", "Start", "initial_guess"]
+__all__ = ["ARAP_STEPS", "PROJECTION_MIN_AREA_RATIO", "Start", "arap_refined", "initial_guess"]
 
 #: Where the projection keeps less than this of the area (slopes above 78°) it squashes the
 #: pattern; when more than :data:`STEEP_SHARE` of the surface is so steep, the conformal map
@@ -36,21 +44,30 @@ PROJECTION_MIN_AREA_RATIO = 0.2
 STEEP_SHARE = 0.01
 #: A start folding more cells than this is not mended locally (the next start is tried).
 MEND_AT_MOST = 1000
+#: Local–global ARAP steps the automatic start of an isotropic problem is taken further (more
+#: gained no Newton iteration on the scan-like example, docs/benchmarks.md).
+ARAP_STEPS = 1
 _NAMES = {"projection": "the projection", "lscm": "the conformal map", "tutte": "Tutte's embedding"}
 
 
 @dataclass(frozen=True)
 class Start:
     """An initial pattern ``(n, 2)``, what it is (``"projection"``, ``"lscm"``, ``"tutte"`` or
-    ``"given"``) and, for a projection, its plane (the pseudo-time path needs it)."""
+    ``"given"``) and, for a projection, its plane (the pseudo-time path needs it).
+    ``refinement``: ``"arap"`` when it was taken further by :func:`arap_refined`."""
 
     coordinates: np.ndarray
     kind: str
     plane: ProjectionPlane | None
+    refinement: str = ""
 
 
 def initial_guess(
-    mesh: SurfaceMesh, options: SolveOptions, given: np.ndarray | None = None
+    mesh: SurfaceMesh,
+    options: SolveOptions,
+    given: np.ndarray | None = None,
+    *,
+    isotropic: bool = False,
 ) -> Start:
     """The start that ``options.initial_guess`` asks for, or the ``given`` coordinates.
 
@@ -63,12 +80,23 @@ def initial_guess(
     projection). The conformal map is not mended: where it folds, it is distorted far around
     (a steep saddle mended from it ended in a minimum that laps over itself, found again from
     Tutte's embedding at twice the cost).
+
+    ``isotropic``: the energy does not depend on the pattern's rotation (an isotropic law, no
+    prestress); the automatic start is then refined by :func:`arap_refined` (not for
+    pseudo-time stepping, whose path starts from the projection itself).
     """
     if given is not None:
         return _given(mesh, options, given)
     plane = projection_plane(mesh, options.plane)
     if options.initial_guess != "auto":
         return _make(mesh, options.initial_guess, plane)
+    start = _automatic(mesh, options, plane)
+    if isotropic and options.strategy != "pseudo-time":
+        return arap_refined(mesh, start, solver=get_solver(options.linear_solver))
+    return start
+
+
+def _automatic(mesh: SurfaceMesh, options: SolveOptions, plane: ProjectionPlane) -> Start:
     steep = squashed_share(mesh, plane, PROJECTION_MIN_AREA_RATIO) > STEEP_SHARE
     order = ["projection", "lscm", "tutte"]
     if options.strategy == "pseudo-time":
@@ -89,10 +117,79 @@ def initial_guess(
                 start, inverted = Start(mended, kind, start.plane), inverted[:0]
         if not inverted.size:
             if folded:
-                warnings.warn(f"{'; '.join(folded)}: started from {_NAMES[kind]}", stacklevel=3)
+                warnings.warn(f"{'; '.join(folded)}: started from {_NAMES[kind]}", stacklevel=4)
             return start
         folded.append(f"{_NAMES[kind]} folds {inverted.size} cell(s)")
     return _make(mesh, order[0], plane)
+
+
+def arap_refined(
+    mesh: SurfaceMesh,
+    start: Start,
+    steps: int = ARAP_STEPS,
+    solver: LinearSolver | None = None,
+) -> Start:
+    """``start`` taken ``steps`` local–global ARAP steps further (:mod:`vares.geometry.arap`)
+    and moved rigidly back onto it: so that the nodes that hold an isotropic pattern's rigid
+    modes (:func:`~vares.mechanics.rigid.rigid_modes`, ``"fixed"``: the node of least x, and
+    the y of the node of greatest x) are where they were, when they are the same nodes (Newton's
+    method then ends at the very pattern it reaches from ``start``); otherwise by least squares
+    (the same pattern, moved by a small rigid motion). ``start`` itself where the steps fold a
+    cell. ``solver``: the linear solver that factorises the Laplacian (default SciPy's SuperLU;
+    PARDISO factorised the 100k-triangle hypar's in a fraction of SuperLU's 2.2 s)."""
+    flat = ArapFlattening(mesh) if solver is None else ArapFlattening(mesh, _factorizer(solver))
+    x = start.coordinates
+    for _ in range(steps):
+        x = flat.step(x)
+    if inverted_cells(mesh, x).size:
+        return start
+    x = _fitted(x, start.coordinates)
+    held = rigid_modes(start.coordinates, "fixed")[0]
+    placed = _held_where_they_were(x, start.coordinates, held)
+    if placed is not None and np.array_equal(rigid_modes(placed, "fixed")[0], held):
+        x = placed
+    return replace(start, coordinates=x, refinement="arap")
+
+
+def _factorizer(solver: LinearSolver):
+    """A function from a symmetric positive definite matrix to its solver ``rhs ↦ x``."""
+
+    def factorize(matrix):
+        solver.factorize(matrix.tocsr(), definite=True)
+        return solver.solve
+
+    return factorize
+
+
+def _fitted(x: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """``x`` moved rigidly to fit ``target`` in least squares (Kabsch, no reflection)."""
+    centre, target_centre = x.mean(axis=0), target.mean(axis=0)
+    u, _, vt = np.linalg.svd((x - centre).T @ (target - target_centre))
+    rotation = u @ np.diag([1.0, np.sign(np.linalg.det(u @ vt))]) @ vt
+    return target_centre + (x - centre) @ rotation
+
+
+def _held_where_they_were(x: np.ndarray, target: np.ndarray, held: np.ndarray) -> np.ndarray | None:
+    """``x`` moved rigidly so that the node whose dofs ``held`` holds is at its ``target``
+    position and the node whose y alone it holds at its ``target`` y (``None`` if no rigid
+    motion can)."""
+    first = int(np.flatnonzero(~held[0::2])[0])
+    second = np.flatnonzero(~held[1::2])
+    second = second[second != first]
+    if not second.size:
+        return None
+    second = int(second[0])
+    arm = x[second] - x[first]
+    rise = target[second, 1] - target[first, 1]
+    length = float(np.hypot(*arm))
+    if not abs(rise) < length:
+        return None
+    turn = np.arcsin(rise / length) - np.arctan2(arm[1], arm[0])
+    c, s = np.cos(turn), np.sin(turn)
+    placed = target[first] + (x - x[first]) @ np.array([[c, s], [-s, c]])
+    placed[first] = target[first]
+    placed[second, 1] = target[second, 1]  # exactly, not to round-off
+    return placed
 
 
 def _make(mesh: SurfaceMesh, kind: str, plane: ProjectionPlane, conformal=None) -> Start:
