@@ -11,8 +11,19 @@ import vares
 from vares.analysis import Pattern, erect
 from vares.analysis.erection_model import patterns_of
 from vares.analysis.erection_optimum import optimise_for_erection, optimised_results
-from vares.analysis.erection_residuals import PatternLayout, ResidualModel, moved, seam_edges
-from vares.analysis.erection_sensitivity import block_derivatives
+from vares.analysis.erection_residuals import (
+    PatternLayout,
+    ResidualModel,
+    moved,
+    seam_edges,
+    stiffness_preconditioner,
+)
+from vares.analysis.erection_sensitivity import (
+    block_derivatives,
+    block_forces,
+    yarn_force,
+    yarn_force_gradients,
+)
 from vares.geometry.elements import ELEMENTS
 from vares.materials import NeoHooke
 from vares.mechanics.erection import ErectionProblem, membrane_block
@@ -97,6 +108,43 @@ def test_block_derivatives_by_central_differences(cell_type, law, wrinkling):
     np.testing.assert_allclose(exact.force_by_x, by_x, atol=1e-7 * np.abs(by_x).max())
 
 
+@pytest.mark.parametrize("symmetric", [True, False], ids=["symmetric", "general"])
+def test_yarn_force_gradients_in_closed_form_against_complex_step(symmetric):
+    """``∂n/∂C`` and ``∂n/∂S`` of the yarn force in closed form against the complex step of
+    :func:`yarn_force`, entry by entry (round-off), for yarns along and across the axes."""
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(6, 2, 2, 2))
+    C = A @ np.swapaxes(A, -1, -2) + np.eye(2)
+    S = rng.normal(size=(6, 2, 2, 2))
+    if symmetric:
+        S = S + np.swapaxes(S, -1, -2)
+    else:
+        C = C + 0.1 * rng.normal(size=C.shape)
+    h = 1e-30
+    for direction in (np.array([1.0, 0.0]), np.array([0.6, 0.8])):
+        n, by_C, by_S = yarn_force_gradients(C, S, direction)
+        np.testing.assert_allclose(n, yarn_force(C, S, direction), rtol=1e-14)
+        for i in range(2):
+            for j in range(2):
+                step = np.zeros((2, 2), complex)
+                step[i, j] = 1j * h
+                dC = yarn_force(C + step, S.astype(complex), direction).imag / h
+                dS = yarn_force(C.astype(complex), S + step, direction).imag / h
+                np.testing.assert_allclose(by_C[..., i, j], dC, atol=1e-13 * np.abs(dC).max())
+                np.testing.assert_allclose(by_S[..., i, j], dS, atol=1e-13 * np.abs(dS).max())
+
+
+def test_block_forces_are_the_derivatives_forces():
+    """The forces alone (what a trial step's objective needs) are those that come with the
+    derivatives, on a relaxed erection with wrinkled points."""
+    mesh = vares.examples.hypar(n=4)
+    solved = vares.solve(mesh, PES, prestress=0.05, warp_direction=(1.0, 0.3, 0.0))
+    problem = _problem(mesh, 0.999 * solved.material_coordinates, PES, solved.fibres, True)
+    x = mesh.points + 0.02 * np.random.default_rng(0).normal(size=mesh.points.shape)
+    forces = block_forces(problem, 0, x)
+    np.testing.assert_allclose(forces, block_derivatives(problem, 0, x).forces, rtol=1e-14)
+
+
 def _taut_hypar():
     mesh = vares.examples.hypar(size=10.0, rise=0.02, n=8)
     return vares.solve(mesh, NeoHooke(E=600.0, nu=0.3), prestress=2.0)
@@ -122,14 +170,19 @@ def test_jacobian_products_by_finite_differences_and_their_adjoint():
     rng = np.random.default_rng(0)
     v = 1e-3 * rng.normal(size=layout.num_variables)
     h = 1e-3
-    residuals = []
+    residuals, positions = [], []
     for sign in (1.0, -1.0):
         shifted = moved(patterns, layout.split(sign * h * v))
         erected = erect(shifted, law, 1.0, solver=tight, start=start.erected_points)
         residuals.append(model(shifted, erected).residual)
+        positions.append(erected.erected_points.ravel()[start.context.assembler.free])
     difference = (residuals[0] - residuals[1]) / (2 * h)
-    product = at.matvec(v)
+    product, dx = at.response(v)
     assert np.abs(difference - product).max() < 1e-6 * np.abs(product).max()
+    np.testing.assert_array_equal(product, at.matvec(v))
+    # the erected positions' change, from which a trial step's erection starts
+    moved_by = (positions[0] - positions[1]) / (2 * h)
+    assert np.abs(moved_by - dx).max() < 1e-6 * np.abs(dx).max()
     u = rng.normal(size=len(at.residual))
     assert u @ product == pytest.approx(v @ at.rmatvec(u), rel=1e-10)
 
@@ -232,3 +285,39 @@ def test_an_optimised_pattern_that_laps_over_itself_is_refused(monkeypatch):
     np.testing.assert_array_equal(
         optimum.patterns[0].material_coordinates, solved.material_coordinates
     )
+
+
+def test_the_preconditioned_step_is_the_same_step():
+    """LSQR preconditioned by the patterns' stiffness solves the same damped least-squares
+    problem: solved tightly, the same step as plain LSQR's (1e-6); in 15 iterations (the
+    optimiser's limit) it lowers the damped objective ``|J Δ + r|² + μ |Δ|²`` further than 15
+    plain iterations do (the 1,568-triangle PES/PVC hypar of the benchmark)."""
+    from vares.analysis import erection_optimum as optimum
+
+    mesh = vares.examples.hypar(size=10.0, rise=0.06, n=28)
+    solved = vares.solve(mesh, PES, prestress=(2.0, 1.5), warp_direction=(1.0, 0.0, 0.0))
+    patterns = patterns_of(solved)
+    start = erect(patterns, PES, 1.0)
+    layout = PatternLayout(patterns, start)
+    seams = seam_edges(patterns, start, layout)
+    at = ResidualModel(patterns, start, layout, seams, (1.0, 0.01), 0.1, None, None)
+    op = at.operator()
+    mu = optimum.INITIAL_DAMPING * optimum._norm_squared(op)
+    preconditioner = stiffness_preconditioner(patterns, PES, 1.0)
+
+    def damped(step):
+        return float(np.sum((at.residual + op.matvec(step)) ** 2) + mu * step @ step)
+
+    assert optimum.LSQR_LIMIT == 15
+    short, _ = optimum._lsqr(op, at, mu, preconditioner)
+    short_plain, _ = optimum._lsqr(op, at, mu)
+    limit, tolerance = optimum.LSQR_LIMIT, optimum.LSQR_TOLERANCE
+    try:
+        optimum.LSQR_LIMIT, optimum.LSQR_TOLERANCE = 3000, 1e-12
+        plain, _ = optimum._lsqr(op, at, mu)
+        tight, _ = optimum._lsqr(op, at, mu, preconditioner)
+    finally:
+        optimum.LSQR_LIMIT, optimum.LSQR_TOLERANCE = limit, tolerance
+    assert np.linalg.norm(tight - plain) < 1e-6 * np.linalg.norm(plain)
+    least = damped(plain)
+    assert damped(short) - least < 0.5 * (damped(short_plain) - least)

@@ -18,14 +18,21 @@ start's largest). Seams are constraints: every seam edge equally long in the two
 joins, each step projected onto them and the patterns matched again to round-off after it.
 
 The minimisation is Levenberg–Marquardt (a Gauss–Newton model of ``J``, damped by ``μ``; a step
-is taken only if ``J`` falls, ``μ`` follows the ratio of the actual to the predicted decrease).
-Its Jacobian is never formed: products with it and its transpose take one solve each with the
-erection's tangent ``K`` (factorised once per iteration), ``dx* = −K⁻¹ (∂R/∂X) dX`` and the
-adjoint ``Jᵀu = ∂r/∂Xᵀ u − (∂R/∂X)ᵀ K⁻¹ ∂r/∂xᵀ u`` (:mod:`vares.analysis.erection_sensitivity`),
-and LSQR solves each step's least-squares problem. It stops when a step lowers ``J`` by less than
-``tolerance`` of it, when nothing is left above round-off, or after ``optimise_iterations``
-steps. Patterns stay one-to-one (a step that inverts a pattern cell is refused like one that
-raises ``J``).
+is taken only if ``J`` falls, ``μ`` follows the ratio of the actual to the predicted decrease)
+in a trust region on the patterns' edge lengths: no step changes one by more than a strain that
+starts at 10 %, doubles after a good step that reached it and halves after a poor one; a refused
+step is tried again half as long along the same direction. Its Jacobian is never formed:
+products with it and its transpose take one solve each with the erection's tangent ``K``
+(factorised once per accepted state), ``dx* = −K⁻¹ (∂R/∂X) dX`` and the adjoint
+``Jᵀu = ∂r/∂Xᵀ u − (∂R/∂X)ᵀ K⁻¹ ∂r/∂xᵀ u`` (:mod:`vares.analysis.erection_sensitivity`), and
+LSQR solves each step's least-squares problem, preconditioned by the inverse of the starting
+patterns' stiffness (:func:`~vares.analysis.erection_residuals.stiffness_preconditioner`: 15
+iterations make the step 30 plain ones made). A trial step's erection starts from the erected
+state moved by its linearised change ``dx*`` (Newton's method then needs fewer iterations than
+from the last state), and only an accepted state is linearised. It stops when a step lowers
+``J`` by less than ``tolerance`` of it, when nothing is left above round-off, or after
+``optimise_iterations`` steps. Patterns stay one-to-one (a step that inverts a pattern cell is
+refused like one that raises ``J``).
 """
 
 from __future__ import annotations
@@ -41,6 +48,7 @@ import scipy.sparse.linalg as spla
 from ..materials import Hyperelastic
 from ..mechanics.problem import Problem
 from ..options import split_settings, takes_options
+from ..solver.linear import quiet_blas
 from ..solver.options import SolveOptions
 from ..solver.result import PatternResult
 from .erection import ErectionResult, erect
@@ -48,10 +56,13 @@ from .erection_model import Pattern, patterns_of
 from .erection_residuals import (
     PatternLayout,
     ResidualModel,
+    edge_strain,
     erected_rms,
     matched,
     moved,
+    pattern_edges,
     seam_edges,
+    stiffness_preconditioner,
 )
 from .options import ErectionOptions
 
@@ -59,22 +70,28 @@ __all__ = ["OptimisedPatterns", "OptimumRecord", "optimise_for_erection", "optim
 
 #: The first damping ``μ``, relative to ``|J|²``; it follows the gain ratio (Nielsen's rule).
 INITIAL_DAMPING = 1e-3
-#: No step changes a pattern edge's length by more than this strain.
-MAX_STEP_STRAIN = 0.02
+#: The trust region of a step: the largest change of a pattern edge's length it may make (a
+#: strain), at first, at most, and below which a refused step's direction is given up.
+INITIAL_STEP_STRAIN = 0.1
+MAX_STEP_STRAIN = 0.2
+MIN_STEP_STRAIN = 1e-4
 #: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
 LSQR_TOLERANCE = 1e-3
-LSQR_LIMIT = 30
+LSQR_LIMIT = 15
 #: Deviations are measured against the start's, but at least against a force of this strain
-#: times the stiffness and a length of 1e-3 of it times the size; deviations below these are
-#: round-off, nothing is left to gain.
-FLOOR = 1e-8
+#: times the stiffness and a length of this fraction of the size; deviations below these are
+#: round-off, nothing is left to gain (the erections are solved to 1e-10 of the stiffness: an
+#: RMS force deviation of 1e-9 of it still leaves each cell's within a few 1e-9).
+FORCE_FLOOR = 1e-9
+SHAPE_FLOOR = 1e-11
 
 
 @dataclass(frozen=True)
 class OptimumRecord:
     """One iteration: the objective ``J`` and its force and shape parts, the erected RMS force
     deviation, the largest and RMS shape deviation, the largest seam mismatch (length units),
-    the damping ``μ``, LSQR's iterations and whether the step was taken."""
+    the damping ``μ``, LSQR's iterations, whether the step was taken and the Newton iterations
+    of its trial erection."""
 
     iteration: int
     objective: float
@@ -87,6 +104,7 @@ class OptimumRecord:
     damping: float
     lsqr_iterations: int
     accepted: bool
+    erection_iterations: int = 0
 
 
 @dataclass
@@ -176,8 +194,13 @@ def optimise_for_erection(
     settings
         Any field of :class:`ErectionOptions` as a keyword (listed below).
     """
-    started = time.perf_counter()
     (options,) = split_settings(settings, [options or ErectionOptions()])
+    with quiet_blas():  # LSQR's vector operations beside PARDISO's solves (quiet_blas docs)
+        return _optimise(source, material, thickness, solver, options, tolerance, callback)
+
+
+def _optimise(source, material, thickness, solver, options, tolerance, callback):
+    started = time.perf_counter()
     shape_weight, shape_bound = options.shape_weight, options.shape_bound
     iterations = options.optimise_iterations
     patterns = patterns_of(source)
@@ -199,10 +222,10 @@ def optimise_for_erection(
         )
     layout = PatternLayout(patterns, first)
     seams = seam_edges(patterns, first, layout)
-    # the start's deviations, but never below a strain of 1e-8 × the stiffness in force and
-    # 1e-9 of the size in shape (a pattern at the round-off of its solve is left as it is)
+    # the start's deviations, but never below the floors (a pattern at the round-off of its
+    # solve is left as it is)
     size = float(np.ptp(first.mesh.points, axis=0).max())
-    floors = (FLOOR * material.stiffness_scale * thickness, 1e-3 * FLOOR * size)
+    floors = (FORCE_FLOOR * material.stiffness_scale * thickness, SHAPE_FLOOR * size)
     scales = (max(erected_rms(first), floors[0]), max(first.deviation()["rms"], floors[1]))
     negligible = ((floors[0] / scales[0]) ** 2, shape_weight * (floors[1] / scales[1]) ** 2)
     bound = None if shape_bound is None else shape_bound * first.deviation()["max"]
@@ -216,40 +239,55 @@ def optimise_for_erection(
     history = [_record(0, objective, model, erected, current, seams, 0.0, 0, True)]
     if callback is not None:
         callback(history[-1])
-    edges = _pattern_edges(patterns, layout)
+    edges = pattern_edges(patterns, layout)
+    preconditioner = None  # made for the first step (none where the start is at round-off)
     mu, reason, converged = None, None, False
+    radius, step, step_strain = INITIAL_STEP_STRAIN, None, 0.0
     for iteration in range(1, iterations + 1):
         if model.parts[0] <= negligible[0] and model.parts[1] <= negligible[1]:  # round-off
             converged = True
             break
-        op = model.operator()
-        if mu is None:
-            mu = INITIAL_DAMPING * _norm_squared(op)
-        step, lsqr_its = _lsqr(op, model, mu)
-        if len(seams):
-            step = model.projection()(step)  # seams kept matched to first order
-        strain = _edge_strain(current, step, edges, layout)
-        if strain > MAX_STEP_STRAIN:
-            step *= MAX_STEP_STRAIN / strain
-        predicted = objective - float(np.sum((model.residual + op.matvec(step)) ** 2))
+        lsqr_its = 0
+        if step is None:  # a new Levenberg–Marquardt step (after a refused one: shorter)
+            op = model.operator()
+            if mu is None:
+                mu = INITIAL_DAMPING * _norm_squared(op)
+                preconditioner = stiffness_preconditioner(patterns, material, thickness)
+            step, lsqr_its = _lsqr(op, model, mu, preconditioner)
+            if len(seams):
+                step = model.projection()(step)  # seams kept matched to first order
+            step_strain = edge_strain(current, step, edges, layout)
+        scale = min(1.0, radius / step_strain) if step_strain > 0 else 1.0
+        change, dx = model.response(scale * step)
+        predicted = objective - float(np.sum((model.residual + change) ** 2))
         if predicted < 0.1 * tolerance * objective:
             converged = True  # the model promises no more
             break
-        trial = matched(moved(current, layout.split(step)), seams, layout)
-        attempt = _trial_erection(trial, material, thickness, solver, options, erected)
-        accepted, decrease = False, 0.0
+        trial = matched(moved(current, layout.split(scale * step)), seams, layout)
+        attempt, newton = _trial_erection(
+            trial, material, thickness, solver, options, erected, _predicted(erected, dx)
+        )
+        accepted, decrease, gain = False, 0.0, -1.0
         if attempt is not None:
             trial_model = model_of(trial, attempt)
             value = float(trial_model.residual @ trial_model.residual)
-            gain = (objective - value) / predicted if predicted > 0 else -1.0
+            gain = (objective - value) / predicted
             if value < objective:
                 accepted, decrease = True, (objective - value) / objective
                 current, erected, model, objective = trial, attempt, trial_model, value
-                mu *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
-        if not accepted:
-            mu *= 4.0
+        taken = scale * step_strain
+        if accepted:
+            mu *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
+            if gain > 0.75 and scale < 1.0:
+                radius = min(2.0 * radius, MAX_STEP_STRAIN)
+            elif gain < 0.25:
+                radius = 0.5 * taken
+            step = None
+        else:  # the same direction, half as long; the next direction damped more
+            mu *= 2.0
+            radius = 0.5 * taken
         record = _record(
-            iteration, objective, model, erected, current, seams, mu, lsqr_its, accepted
+            iteration, objective, model, erected, current, seams, mu, lsqr_its, accepted, newton
         )
         history.append(record)
         if callback is not None:
@@ -257,6 +295,8 @@ def optimise_for_erection(
         if accepted and decrease < tolerance:
             converged = True
             break
+        if not accepted and taken < MIN_STEP_STRAIN:
+            break  # no step along the model's direction lowers the objective
     else:
         converged = True  # every step taken lowered the objective: the patterns are usable
     if not converged:
@@ -289,12 +329,29 @@ def _overlapping(patterns: list[Pattern]) -> str | None:
     return None
 
 
-def _lsqr(op, model, mu):
+def _lsqr(op, model, mu, preconditioner=None):
     """The Levenberg–Marquardt step ``min |J Δ + r|² + μ |Δ|²`` (to LSQR's loose tolerance: the
-    step is inexact) and LSQR's iterations."""
+    step is inexact) and LSQR's iterations; with a right ``preconditioner`` ``P`` (symmetric),
+    ``Δ = P y`` and LSQR solves for ``y`` the same problem, ``min |J P y + r|² + μ |P y|²``."""
     tol = LSQR_TOLERANCE
-    out = spla.lsqr(op, -model.residual, damp=np.sqrt(mu), atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
-    return out[0], out[2]
+    if preconditioner is None:
+        out = spla.lsqr(
+            op, -model.residual, damp=np.sqrt(mu), atol=tol, btol=tol, iter_lim=LSQR_LIMIT
+        )
+        return out[0], out[2]
+    rows, root = len(model.residual), np.sqrt(mu)
+
+    def matvec(y):
+        step = preconditioner.matvec(y)
+        return np.concatenate([op.matvec(step), root * step])
+
+    def rmatvec(u):
+        return preconditioner.matvec(op.rmatvec(u[:rows]) + root * u[rows:])
+
+    augmented = spla.LinearOperator((rows + op.shape[1], op.shape[1]), matvec, rmatvec, dtype=float)
+    rhs = np.concatenate([-model.residual, np.zeros(op.shape[1])])
+    out = spla.lsqr(augmented, rhs, atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
+    return preconditioner.matvec(out[0]), out[2]
 
 
 def _norm_squared(op, iterations: int = 4) -> float:
@@ -309,37 +366,32 @@ def _norm_squared(op, iterations: int = 4) -> float:
     return value
 
 
-def _trial_erection(trial, material, thickness, solver, options, erected):
-    """The erection of trial patterns from the last erected state, or None where a pattern
-    cell turned over or the erection did not converge."""
-    try:
-        attempt = _erect(trial, material, thickness, solver, options, erected.erected_points)
-    except ValueError:  # a pattern cell turned over
-        return None
-    return attempt if attempt.converged else None
+def _predicted(erected: ErectionResult, dx: np.ndarray) -> np.ndarray:
+    """The erected positions ``(n, 3)`` moved by the linearised change ``dx`` (free dofs)."""
+    x = erected.erected_points.copy()
+    x.reshape(-1)[erected.context.assembler.free] += dx
+    return x
 
 
-def _pattern_edges(patterns: list[Pattern], layout: PatternLayout) -> np.ndarray:
-    """Every edge of every pattern cell ``(k, 2)`` (variable node ids)."""
-    out = []
-    for p, pattern in enumerate(patterns):
-        for cells in pattern.mesh.cells.values():
-            rolled = np.roll(cells, -1, axis=1)
-            out.append(layout.offsets[p] + np.column_stack([cells.ravel(), rolled.ravel()]))
-    return np.unique(np.sort(np.vstack(out), axis=1), axis=0)
+def _trial_erection(trial, material, thickness, solver, options, erected, predicted):
+    """The erection of trial patterns from the linearised prediction of their erected state
+    (from the last erected state where that fails) and its Newton iterations, or ``(None, n)``
+    where a pattern cell turned over or the erection did not converge."""
+    newton = 0
+    for start in (predicted, erected.erected_points):
+        try:
+            attempt = _erect(trial, material, thickness, solver, options, start)
+        except ValueError:  # a pattern cell turned over
+            return None, newton
+        newton += attempt.iterations
+        if attempt.converged:
+            return attempt, newton
+    return None, newton
 
 
-def _edge_strain(patterns, step, edges, layout) -> float:
-    """The largest change of a pattern edge's length by ``step``, relative to its length."""
-    X = np.concatenate([p.material_coordinates for p in patterns])
-    d = step.reshape(-1, 2)
-    vectors = X[edges[:, 1]] - X[edges[:, 0]]
-    lengths = np.linalg.norm(vectors, axis=1)
-    change = np.einsum("ki,ki->k", vectors, d[edges[:, 1]] - d[edges[:, 0]]) / lengths
-    return float(np.max(np.abs(change) / lengths))
-
-
-def _record(iteration, objective, model, erected, patterns, seams, mu, lsqr_its, accepted):
+def _record(
+    iteration, objective, model, erected, patterns, seams, mu, lsqr_its, accepted, newton=0
+):
     deviation = erected.deviation()
     mismatch = 0.0
     if len(seams):
@@ -359,6 +411,7 @@ def _record(iteration, objective, model, erected, patterns, seams, mu, lsqr_its,
         mu,
         int(lsqr_its or 0),
         accepted,
+        newton,
     )
 
 

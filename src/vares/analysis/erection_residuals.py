@@ -18,20 +18,26 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..materials import Hyperelastic
+from ..mechanics.assembly import Assembler
+from ..mechanics.problem import Problem
 from ..solver.linear import get_solver
 from .erection import ErectionResult
 from .erection_fields import node_normals
 from .erection_model import Pattern
-from .erection_sensitivity import block_derivatives
+from .erection_sensitivity import block_derivatives, block_forces
 
 __all__ = [
     "PatternLayout",
     "ResidualModel",
+    "edge_strain",
     "erected_rms",
     "matched",
     "moved",
+    "pattern_edges",
     "seam_constraints",
     "seam_edges",
+    "stiffness_preconditioner",
 ]
 
 #: Seam edges are matched again after every step until their lengths differ by at most this
@@ -43,6 +49,10 @@ MATCH_STEPS = 5
 MEAN_WEIGHT = 30.0
 #: The weight of a node's shape deviation beyond the bound, against the RMS terms.
 BOUND_WEIGHT = 100.0
+#: The shift of the patterns' stiffness in LSQR's preconditioner, relative to its mean diagonal
+#: (measured on the 10k hypar: 0.1 to 1 alike; 10 preconditioned iterations reach what 30
+#: plain ones do).
+PRECONDITIONER_SHIFT = 0.3
 
 
 class PatternLayout:
@@ -121,7 +131,12 @@ def matched(patterns: list[Pattern], seams: np.ndarray, layout: PatternLayout) -
 
 
 class ResidualModel:
-    """The residual vector of ``J`` at one erected state and products with its Jacobian."""
+    """The residual vector of ``J`` at one erected state and products with its Jacobian.
+
+    The residual is cheap (the cells' forces and the nodes' deviations); the linearisation (the
+    derivatives' sparse matrices and the factorised erection tangent ``K``) is made on the first
+    product with the Jacobian and then serves every product at this state (a trial whose
+    objective is not lower is never linearised)."""
 
     def __init__(
         self,
@@ -135,22 +150,74 @@ class ResidualModel:
         linear_solver: str | None,
     ) -> None:
         self.erected, self.layout, self.seams = erected, layout, seams
-        problem, ctx = erected.problem, erected.context
-        x = erected.erected_points
-        mesh = erected.mesh
+        self.linear_solver = linear_solver
+        problem, x, mesh = erected.problem, erected.erected_points, erected.mesh
         area = mesh.cell_areas()
         total = area.sum()
         force_scale, shape_scale = scales
         n_cells, n_nodes = mesh.num_cells, mesh.num_points
-        # forces and their derivatives, block by block
         forces = np.zeros((n_cells, 2))
+        for k in range(len(problem.blocks)):
+            forces[layout.cell_ids[k]] = block_forces(problem, k, x)
+        # per cell and yarn the force deviation, and per yarn its mean (held near zero)
+        force_weight = np.repeat(np.sqrt(area / total), 2) / force_scale
+        mean_rows = sp.csr_matrix(
+            (
+                np.tile(area / total, 2) * np.sqrt(MEAN_WEIGHT) / force_scale,
+                (
+                    np.repeat([0, 1], n_cells),
+                    np.concatenate([2 * np.arange(n_cells) + k for k in (0, 1)]),
+                ),
+            ),
+            shape=(2, 2 * n_cells),
+        )
+        self._force_rows = sp.vstack([sp.diags(force_weight), mean_rows]).tocsr()
+        force_residual = self._force_rows @ (forces - erected.intended).ravel()
+        # shape: the normal deviation at every node (its derivative the normal itself), and
+        # where it exceeds the bound, the excess
+        normals, node_area = node_normals(mesh)
+        d = erected.normal_deviation
+        rms_weight = np.sqrt(shape_weight * node_area / total) / shape_scale
+        over = np.zeros(n_nodes)
+        if shape_bound is not None:
+            active = np.abs(d) > shape_bound
+            over[active] = np.sqrt(BOUND_WEIGHT * node_area[active] / total) / shape_scale
+        excess = over * (np.abs(d) - (shape_bound or 0.0))
+        self._shape_rows = (np.concatenate([rms_weight, over * np.sign(d)]), normals)
+        shape_residual = np.concatenate([rms_weight * d, excess])
+        # seams: the two lengths of every seam edge, equal
+        self.seam_residual, self.seam_by_X = self._seams(patterns)
+        self.residual = np.concatenate([force_residual, shape_residual])
+        self.parts = (
+            float(force_residual @ force_residual),
+            float(shape_residual @ shape_residual),
+        )
+        self.forces = forces
+        self.num_force, self.num_shape = len(force_residual), len(shape_residual)
+        self.solves = 0
+        self._linear = None
+
+    def _seams(self, patterns: list[Pattern]):
+        """The seam constraints ``c = ℓ_P − ℓ_Q`` (one per seam edge) and their Jacobian."""
+        X = np.concatenate([p.material_coordinates for p in patterns])
+        return seam_constraints(X, self.seams, self.layout.num_variables)
+
+    def linearise(self) -> None:
+        """The derivatives at this state as sparse matrices (``mixed`` ``∂R/∂X`` on the free
+        dofs, ``by_x`` and ``by_X`` the residuals' by the free positions and by the patterns)
+        and the erection tangent ``K`` factorised (``tangent``, ``solver``)."""
+        if self._linear is not None:
+            return
+        erected, layout = self.erected, self.layout
+        problem, ctx = erected.problem, erected.context
+        x, mesh = erected.erected_points, erected.mesh
+        n_cells, n_nodes = mesh.num_cells, mesh.num_points
         mixed_rows, mixed_cols, mixed_vals = [], [], []
         fx_rows, fx_cols, fx_vals = [], [], []
         fX_rows, fX_cols, fX_vals = [], [], []
         for k, block in enumerate(problem.blocks):
             d = block_derivatives(problem, k, x)
             ids = layout.cell_ids[k]
-            forces[ids] = d.forces
             nen = block.cells.shape[1]
             xdof = 3 * block.cells[:, :, None] + np.arange(3)  # (m, nen, 3)
             Xdof = 2 * layout.block_cells[k][:, :, None] + np.arange(2)  # (m, nen, 2)
@@ -168,42 +235,17 @@ class ResidualModel:
             fX_vals.append(d.force_by_X.ravel())
         nv = layout.num_variables
         cat = np.concatenate
+        free = ctx.assembler.free
+        kept = np.flatnonzero(free)
         mixed = sp.csr_matrix(
             (cat(mixed_vals), (cat(mixed_rows), cat(mixed_cols))), shape=(3 * n_nodes, nv)
         )
-        free = ctx.assembler.free
         self.mixed = mixed[free]
         raw_x = sp.csr_matrix(
             (cat(fx_vals), (cat(fx_rows), cat(fx_cols))), shape=(2 * n_cells, 3 * n_nodes)
-        ).tocsc()[:, np.flatnonzero(free)]
+        ).tocsc()[:, kept]
         raw_X = sp.csr_matrix((cat(fX_vals), (cat(fX_rows), cat(fX_cols))), shape=(2 * n_cells, nv))
-        # per cell and yarn the force deviation, and per yarn its mean (held near zero)
-        force_weight = np.repeat(np.sqrt(area / total), 2) / force_scale
-        mean_rows = sp.csr_matrix(
-            (
-                np.tile(area / total, 2) * np.sqrt(MEAN_WEIGHT) / force_scale,
-                (
-                    np.repeat([0, 1], n_cells),
-                    np.concatenate([2 * np.arange(n_cells) + k for k in (0, 1)]),
-                ),
-            ),
-            shape=(2, 2 * n_cells),
-        )
-        rows_of = sp.vstack([sp.diags(force_weight), mean_rows]).tocsr()
-        self.by_x = rows_of @ raw_x
-        self.by_X = rows_of @ raw_X
-        force_residual = rows_of @ (forces - erected.intended).ravel()
-        # shape: the normal deviation at every node (its derivative the normal itself), and
-        # where it exceeds the bound, the excess
-        normals, node_area = node_normals(mesh)
-        d = erected.normal_deviation
-        rms_weight = np.sqrt(shape_weight * node_area / total) / shape_scale
-        over = np.zeros(n_nodes)
-        if shape_bound is not None:
-            active = np.abs(d) > shape_bound
-            over[active] = np.sqrt(BOUND_WEIGHT * node_area[active] / total) / shape_scale
-        excess = over * (np.abs(d) - (shape_bound or 0.0))
-        weights = np.concatenate([rms_weight, over * np.sign(d)])
+        weights, normals = self._shape_rows
         rows = np.repeat(np.arange(2 * n_nodes), 3)
         shape_by_x = sp.csr_matrix(
             (
@@ -211,59 +253,56 @@ class ResidualModel:
                 (rows, np.tile(np.arange(3 * n_nodes), 2)),
             ),
             shape=(2 * n_nodes, 3 * n_nodes),
-        ).tocsc()[:, np.flatnonzero(free)]
-        shape_residual = np.concatenate([rms_weight * d, excess])
-        self.by_x = sp.vstack([self.by_x, shape_by_x]).tocsr()
-        # seams: the two lengths of every seam edge, equal
-        self.seam_residual, self.seam_by_X = self._seams(patterns)
-        self.residual = np.concatenate([force_residual, shape_residual])
-        self.parts = (
-            float(force_residual @ force_residual),
-            float(shape_residual @ shape_residual),
-        )
-        self.forces = forces
-        self.num_force, self.num_shape = len(force_residual), len(shape_residual)
-        solver = get_solver(linear_solver)
+        ).tocsc()[:, kept]
+        self.by_X = (self._force_rows @ raw_X).tocsr()
+        self.by_x = sp.vstack([self._force_rows @ raw_x, shape_by_x]).tocsr()
+        self._by_x_t = self.by_x.T.tocsr()
+        self._by_X_t = self.by_X.T.tocsr()
+        self._mixed_t = self.mixed.T.tocsr()
         # the exact tangent where every cell is taut; the film keeps it definite where cells
         # wrinkle (their positions then have no determinate derivative across the wrinkles)
         taut = not erected.fields["state"].any()
         evaluation = problem.evaluate(x, order=2, stabilised=not taut)
-        solver.factorize(ctx.assembler.matrix(evaluation.hessians))
-        self.solver = solver
-        self.solves = 0
-
-    def _seams(self, patterns: list[Pattern]):
-        """The seam constraints ``c = ℓ_P − ℓ_Q`` (one per seam edge) and their Jacobian."""
-        X = np.concatenate([p.material_coordinates for p in patterns])
-        return seam_constraints(X, self.seams, self.layout.num_variables)
+        self.tangent = ctx.assembler.matrix(evaluation.hessians)
+        self.solver = get_solver(self.linear_solver)
+        self.solver.factorize(self.tangent)
+        self._linear = True
 
     def _tangent_solve(self, rhs: np.ndarray) -> np.ndarray:
         self.solves += 1
         return self.solver.solve(rhs)
 
-    def matvec(self, v: np.ndarray) -> np.ndarray:
-        """``J v``: the residuals' change for a change ``v`` of the patterns."""
+    def response(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``J v`` and the erected positions' change ``dx* = −K⁻¹ (∂R/∂X) v`` (free dofs) for a
+        change ``v`` of the patterns: one solve with ``K``."""
+        self.linearise()
         dx = -self._tangent_solve(self.mixed @ v)
         forces = self.by_X @ v + self.by_x[: self.num_force] @ dx
         shape = self.by_x[self.num_force :] @ dx
-        return np.concatenate([forces, shape])
+        return np.concatenate([forces, shape]), dx
+
+    def matvec(self, v: np.ndarray) -> np.ndarray:
+        """``J v``: the residuals' change for a change ``v`` of the patterns."""
+        return self.response(v)[0]
 
     def rmatvec(self, u: np.ndarray) -> np.ndarray:
         """``Jᵀ u`` by the adjoint of the erected equilibrium."""
+        self.linearise()
         nf, ns = self.num_force, self.num_shape
-        adjoint = self._tangent_solve(self.by_x.T @ u[: nf + ns])
-        return self.by_X.T @ u[:nf] - self.mixed.T @ adjoint
+        adjoint = self._tangent_solve(self._by_x_t @ u[: nf + ns])
+        return self._by_X_t @ u[:nf] - self._mixed_t @ adjoint
 
     def operator(self) -> spla.LinearOperator:
         """``J P``: the Jacobian on the steps that keep the seams matched to first order."""
         shape = (len(self.residual), self.layout.num_variables)
         if not len(self.seams):
-            return spla.LinearOperator(shape, matvec=self.matvec, rmatvec=self.rmatvec)
+            return spla.LinearOperator(shape, matvec=self.matvec, rmatvec=self.rmatvec, dtype=float)
         project = self.projection()
         return spla.LinearOperator(
             shape,
             matvec=lambda v: self.matvec(project(v)),
             rmatvec=lambda u: project(self.rmatvec(u)),
+            dtype=float,
         )
 
     def projection(self):
@@ -274,6 +313,54 @@ class ResidualModel:
             self._gram = gram
             self._projection = lambda v: v - C.T @ gram.solve(C @ v)
         return self._projection
+
+
+def stiffness_preconditioner(
+    patterns: list[Pattern], material: Hyperelastic, thickness: float
+) -> spla.LinearOperator:
+    """``(H + σ I)⁻¹`` ``(N, N)`` over all patterns' coordinates: ``H`` the patterning energy's
+    Hessian (without prestress, made positive semi-definite) of each pattern on its design
+    shape, one block per panel, ``σ`` :data:`PRECONDITIONER_SHIFT` of its mean diagonal.
+
+    A right preconditioner of LSQR for ``J``: a change of the patterns weighted by the inverse
+    of their stiffness is one the erected forces follow evenly, and LSQR needs about a third of
+    the iterations for the same step (docs/erection.md). The patterns move by a few per cent
+    while they are optimised: the factors of the starting patterns serve every step."""
+    blocks = []
+    for pattern in patterns:
+        problem = Problem(pattern.mesh, material, thickness, fibres=pattern.fibres)
+        evaluation = problem.evaluate(pattern.material_coordinates, order=2, projected=True)
+        free = np.ones(2 * pattern.mesh.num_points, dtype=bool)
+        assembler = Assembler(problem.connectivity, free, dofs_per_node=2)
+        blocks.append(assembler.matrix(evaluation.hessians))
+    H = sp.block_diag(blocks, format="csr")
+    shifted = (H + PRECONDITIONER_SHIFT * H.diagonal().mean() * sp.eye(H.shape[0])).tocsr()
+    # SuperLU, not PARDISO: PARDISO's one handle holds the erection tangent's factors
+    solver = get_solver("scipy-superlu")
+    solver.factorize(shifted)
+    return spla.LinearOperator(H.shape, matvec=solver.solve, rmatvec=solver.solve, dtype=float)
+
+
+def pattern_edges(patterns: list[Pattern], layout: PatternLayout) -> np.ndarray:
+    """Every edge of every pattern cell ``(k, 2)`` (variable node ids)."""
+    out = []
+    for p, pattern in enumerate(patterns):
+        for cells in pattern.mesh.cells.values():
+            rolled = np.roll(cells, -1, axis=1)
+            out.append(layout.offsets[p] + np.column_stack([cells.ravel(), rolled.ravel()]))
+    return np.unique(np.sort(np.vstack(out), axis=1), axis=0)
+
+
+def edge_strain(
+    patterns: list[Pattern], step: np.ndarray, edges: np.ndarray, layout: PatternLayout
+) -> float:
+    """The largest change of a pattern edge's length by ``step``, relative to its length."""
+    X = np.concatenate([p.material_coordinates for p in patterns])
+    d = step.reshape(-1, 2)
+    vectors = X[edges[:, 1]] - X[edges[:, 0]]
+    lengths = np.linalg.norm(vectors, axis=1)
+    change = np.einsum("ki,ki->k", vectors, d[edges[:, 1]] - d[edges[:, 0]]) / lengths
+    return float(np.max(np.abs(change) / lengths))
 
 
 def erected_rms(result: ErectionResult) -> float:

@@ -31,9 +31,13 @@ import numpy as np
 from ..mechanics.erection import ErectionProblem, MembraneBlock
 from ..mechanics.forward import deformation_gradients
 
-__all__ = ["BlockDerivatives", "block_derivatives", "yarn_force"]
-
-_H = 1e-30
+__all__ = [
+    "BlockDerivatives",
+    "block_derivatives",
+    "block_forces",
+    "yarn_force",
+    "yarn_force_gradients",
+]
 
 
 @dataclass(frozen=True)
@@ -59,58 +63,93 @@ def yarn_force(C: np.ndarray, S: np.ndarray, direction: np.ndarray) -> np.ndarra
     return along / length / np.sqrt(det)
 
 
-def _force_gradients(C, S, direction):
-    """``∂n/∂C`` and ``∂n/∂S`` ``(..., 2, 2)`` of :func:`yarn_force`, entry by entry (complex
-    step: exact to round-off)."""
-    by_C, by_S = np.zeros(C.shape), np.zeros(S.shape)
-    for i in range(2):
-        for j in range(2):
-            step = np.zeros((2, 2), complex)
-            step[i, j] = 1j * _H
-            by_C[..., i, j] = yarn_force(C + step, S.astype(complex), direction).imag / _H
-            by_S[..., i, j] = yarn_force(C.astype(complex), S + step, direction).imag / _H
-    return by_C, by_S
+def yarn_force_gradients(
+    C: np.ndarray, S: np.ndarray, direction: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`yarn_force` ``n`` and its derivatives ``∂n/∂C`` and ``∂n/∂S`` ``(..., 2, 2)``,
+    entry by entry, in closed form: with ``a = Φ·CSCΦ``, ``l = Φ·CΦ``, ``n = a / (l √det C)``,
+    ``∂a/∂C = Φ ⊗ SCΦ + SᵀCᵀΦ ⊗ Φ``, ``∂a/∂S = CΦ ⊗ CᵀΦ``, ``∂l/∂C = Φ ⊗ Φ`` and
+    ``∂det C/∂C`` the cofactors (``tests/test_erection_optimum.py`` checks them by complex
+    step)."""
+    phi = np.asarray(direction, dtype=float)
+    C_phi = C @ phi  # CΦ (..., 2)
+    Ct_phi = phi @ C  # CᵀΦ
+    SC_phi = np.einsum("...ab,...b->...a", S, C_phi)
+    StCt_phi = np.einsum("...ba,...b->...a", S, Ct_phi)
+    a = np.einsum("...a,...a->...", Ct_phi, SC_phi)
+    length = np.einsum("a,...a->...", phi, C_phi)
+    det = C[..., 0, 0] * C[..., 1, 1] - C[..., 0, 1] * C[..., 1, 0]
+    scale = 1.0 / (length * np.sqrt(det))
+    n = a * scale
+    cofactors = np.stack(
+        [np.stack([C[..., 1, 1], -C[..., 1, 0]], -1), np.stack([-C[..., 0, 1], C[..., 0, 0]], -1)],
+        -2,
+    )
+    by_a = phi[:, None] * SC_phi[..., None, :] + StCt_phi[..., :, None] * phi[None, :]
+    by_C = (
+        scale[..., None, None] * by_a
+        - (n / length)[..., None, None] * np.outer(phi, phi)
+        - (0.5 * n / det)[..., None, None] * cofactors
+    )
+    by_S = scale[..., None, None] * Ct_phi[..., :, None] * C_phi[..., None, :]
+    return n, by_C, by_S
+
+
+def _points(problem: ErectionProblem, index: int, x: np.ndarray, tangent: bool):
+    block: MembraneBlock = problem.blocks[index]
+    G, w = block.reference.gradients, block.reference.weights  # (m,q,nen,2), (m,q)
+    F = deformation_gradients(np.ascontiguousarray(x[block.cells]), G)  # (m,q,3,2)
+    C = np.swapaxes(F, -1, -2) @ F
+    _, S, cc = problem.response(block.fibres, block=index)(C, tangent)
+    return block, G, w, F, C, np.broadcast_to(S, C.shape), cc
+
+
+def _directions(block: MembraneBlock) -> list[np.ndarray]:
+    warp = (1.0, 0.0) if block.fibres is None else block.fibres.warp
+    fill = (0.0, 1.0) if block.fibres is None else block.fibres.fill
+    return [np.asarray(warp, float), np.asarray(fill, float)]
+
+
+def block_forces(problem: ErectionProblem, index: int, x: np.ndarray) -> np.ndarray:
+    """The membrane forces along warp and fill ``(m, 2)`` of membrane block ``index`` at the
+    erected positions ``x`` ``(n, 3)`` (the cell means of :func:`block_derivatives`)."""
+    block, _, w, _, C, S, _ = _points(problem, index, x, False)
+    total = w.sum(axis=1)
+    forces = [np.sum(w * yarn_force(C, S, d), axis=1) / total for d in _directions(block)]
+    return problem.thickness * np.stack(forces, axis=1)
 
 
 def block_derivatives(problem: ErectionProblem, index: int, x: np.ndarray) -> BlockDerivatives:
     """The derivatives (:class:`BlockDerivatives`) of membrane block ``index`` of ``problem``
     at the erected positions ``x`` ``(n, 3)``, with the problem's law (relaxed or plain)."""
-    block: MembraneBlock = problem.blocks[index]
-    G, w = block.reference.gradients, block.reference.weights  # (m,q,nen,2), (m,q)
-    F = deformation_gradients(np.ascontiguousarray(x[block.cells]), G)  # (m,q,3,2)
-    C = np.swapaxes(F, -1, -2) @ F
-    _, S, cc = problem.response(block.fibres, block=index)(C, True)
-    S = np.broadcast_to(S, C.shape)
+    block, G, w, F, C, S, cc = _points(problem, index, x, True)
     cc = np.broadcast_to(cc, (*C.shape, 2, 2))
-    eye = np.eye(2)
     # δC per pattern dof (b, α): −(G_bβ C_αγ + C_βα G_bγ)
-    dC_X = -(
-        np.einsum("mqbx,ay,mqyz->mqbaxz", G, eye, C) + np.einsum("mqxy,ya,mqbz->mqbaxz", C, eye, G)
-    )
-    dS_X = 0.5 * np.einsum("mqxyuv,mqbauv->mqbaxy", cc, dC_X)
+    GC = np.einsum("mqbx,mqaz->mqbaxz", G, C)
+    dC_X = -(GC + np.swapaxes(GC, -1, -2))
+    dS_X = 0.5 * np.einsum("mqxyuv,mqbauv->mqbaxy", cc, dC_X, optimize=True)
     FS = F @ S
     FSG = np.einsum("mqiy,mqay->mqai", FS, G)  # F S G_a
     dw = w[..., None, None] * G  # δw per (b, α)
+    GSG = np.einsum("mqby,mqcy->mqbc", G @ S, G)
+    FdS = np.einsum("mqiy,mqbayz->mqibaz", F, dS_X)
     mixed = (
         np.einsum("mqba,mqci->mciba", dw, FSG)
-        - np.einsum("mq,mqia,mqby,mqyz,mqcz->mciba", w, F, G, S, G)
-        + np.einsum("mq,mqiy,mqbayz,mqcz->mciba", w, F, dS_X, G)
-        - np.einsum("mq,mqca,mqbi->mciba", w, G, FSG)
+        - np.einsum("mqia,mqbc->mciba", w[..., None, None] * F, GSG)
+        + np.einsum("mqibaz,mqcz->mciba", w[..., None, None, None, None] * FdS, G)
+        - np.einsum("mqca,mqbi->mciba", w[..., None, None] * G, FSG)
     )
-    warp = (1.0, 0.0) if block.fibres is None else block.fibres.warp
-    fill = (0.0, 1.0) if block.fibres is None else block.fibres.fill
     t = problem.thickness
     total = w.sum(axis=1)
     forces, by_x, by_X = [], [], []
-    for direction in (np.asarray(warp, float), np.asarray(fill, float)):
-        n = yarn_force(C, S, direction)  # (m, q)
-        by_C, by_S = _force_gradients(C, S, direction)
+    for direction in _directions(block):
+        n, by_C, by_S = yarn_force_gradients(C, S, direction)  # (m, q), (m, q, 2, 2) ×2
         D = by_C + 0.5 * np.einsum("mqxy,mqxyuv->mquv", by_S, cc)
         mean = np.sum(w * n, axis=1) / total
         # dC by node positions (a, i): G_aβ F_iγ + F_iβ G_aγ
-        dn_x = np.einsum("mquv,mqau,mqiv->mqai", D, G, F) + np.einsum(
-            "mquv,mqiu,mqav->mqai", D, F, G
-        )
+        DF = np.einsum("mquv,mqiv->mqui", D, F)
+        DtF = np.einsum("mquv,mqiu->mqvi", D, F)
+        dn_x = np.einsum("mqau,mqui->mqai", G, DF + DtF)
         forces.append(t * mean)
         by_x.append(t * np.einsum("mq,mqai->mai", w, dn_x) / total[:, None, None])
         dn_X = np.einsum("mquv,mqbauv->mqba", D, dC_X)
