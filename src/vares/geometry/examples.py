@@ -4,6 +4,9 @@
     The named examples (:mod:`vares.geometry.example_surfaces`): the seed paper's cylinder
     segment, a hyperbolic paraboloid, a four-point sail and a panel of a conic tent, a curved
     composite rib, and the whole membranes of the cutting examples.
+``double-dome``
+    A double-dome mould (two domes joined by a saddle, on a flat flange; mm) for composite plies
+    (:mod:`vares.geometry.double_dome`).
 ``hypar-strips``, ``catenoid-band``
     Example structures, surfaces cut into panels (:mod:`vares.geometry.example_structures`).
 ``robustness_suite``, ``real_world_suite``
@@ -19,6 +22,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .double_dome import double_dome, double_dome_height
 from .example_structures import catenoid_band, hypar_strips, irregular_hypar_strips
 from .example_surfaces import (
     conic_tent,
@@ -62,6 +66,8 @@ __all__ = [
     "conic_tent",
     "cylinder160",
     "cylinder_arc_length",
+    "double_dome",
+    "double_dome_height",
     "four_point_sail",
     "graded_hypar",
     "grid_cells",
@@ -83,6 +89,7 @@ __all__ = [
 #: Example generators by name (used by ``vares example``).
 EXAMPLES: dict[str, Callable[..., SurfaceMesh]] = {
     "cylinder160": cylinder160,
+    "double-dome": double_dome,
     "hypar": hypar,
     "rib30": rib30,
     "sail": four_point_sail,
