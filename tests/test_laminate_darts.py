@@ -9,6 +9,7 @@ import ezdxf
 import numpy as np
 import pytest
 from conftest import run
+from test_laminate_cutting import chromium
 
 from vares.analysis.darts import erected_yarns
 from vares.app.job import JobError
@@ -276,6 +277,13 @@ def test_cli_darts_the_plies(tmp_path):
     dart = [e for e in ezdxf.readfile(tmp_path / "out" / "plies" / "A.dxf").modelspace()
             if e.dxf.layer == "DART"]  # fmt: skip
     assert dart
+    # the ply book as Chromium reads it: the darts' table, one row per dart, and the pictures
+    dom = chromium(tmp_path, "--dump-dom", (tmp_path / "out" / "plybook.html").as_uri()).stdout
+    section = dom.split('id="ply-A"')[1].split("</section>")[0]
+    table = section.split('id="darts-table-A"')[1].split("</table>")[0]
+    assert table.count("<tr>") == 1 + len(dart)
+    for kind in ("blank", "shear", "producibility"):
+        assert f'id="figure-A-{kind}"' in section
 
 
 def test_plies_on_a_dask_cluster_are_those_draped_here(darted):
