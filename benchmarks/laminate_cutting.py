@@ -99,7 +99,8 @@ def main() -> None:
         print(f"  drape {drape.label}: locking {darted.locking_angle:g}°, "
               f"{len(darted.dart_lines)} dart(s) [{lengths}], largest shear "
               f"{darted.max_shear_before:.2f}° -> {after}, {len(darted.rounds)} solve(s) with "
-              f"darts, converged {drape.converged}, {drape.seconds:.2f} s")  # fmt: skip
+              f"darts, {'cut with them' if drape.is_darted else 'cut whole'}, "
+              f"converged {drape.converged}, {drape.seconds:.2f} s")  # fmt: skip
     for path in laminate_files(job, result.labels):
         print(f"  {path.relative_to(out)}: {path.stat().st_size / 1024:.0f} KiB")
     if nest is None:
