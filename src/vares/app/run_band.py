@@ -2,7 +2,8 @@
 of a job, ``--scatter`` on ``vares pattern``, ``example``, ``panels`` and ``cut``.
 
 :func:`check_run_band` refuses, before the solve, a job whose band could not be the band of its
-own patterns: no fabric file, a file without the scatter of what is sampled, a run compensated
+own patterns: no fabric file, a file without the scatter of what is sampled (or with that of
+one specimen: unknown), a run compensated
 otherwise than the samples are, a prestress that is not one uniform value, patterns optimised
 for the erected state. :func:`run_band` then patterns the run's panels (one surface, a
 structure's panels, or a cut job's strips, each with the warp it was solved with) by
@@ -98,8 +99,8 @@ def check_run_band(job: Job) -> BandInputs | None:
     if options.sampled == "compensation":
         if by != "measured":
             raise JobError(
-                f"{ASKED}: {path}: the run compensates by the fitted law; its band samples the "
-                "constants: add --scatter-sampled constants ([scatter] sampled = 'constants')"
+                f"{ASKED}: {path}: the run compensates by the fitted law: sample its "
+                "constants, add --scatter-sampled constants ([scatter] sampled = 'constants')"
             )
         c = preset.compensation
         if c is None:
@@ -137,7 +138,11 @@ def check_run_band(job: Job) -> BandInputs | None:
     prestress = job.prestress
     if prestress.field is not None or prestress.warp is None:
         measured = preset.compensation
-        at = "" if measured is None else f"; the fabric was measured at {measured.prestress}"
+        at = (
+            ""
+            if measured is None
+            else "; the fabric was measured at {:g}/{:g}".format(*measured.prestress)
+        )
         raise JobError(
             f"{ASKED} needs one uniform prestress (--prestress WARP,FILL){at}; got "
             + ("a per-cell field" if prestress.field is not None else "none")
