@@ -139,6 +139,7 @@ def test_a_structure_run_writes_the_band_of_every_seam(files, tmp_path):
     result = run(
         "panels", *files["strips"], "--fabric", SHIPPED, "--prestress", "2,1.5",
         "--warp-direction", "1,0,0", "--scatter", "--scatter-samples", 3, "-o", out, "-q",
+        "--report",
     )  # fmt: skip
     assert result.exit_code == 0, result.stderr
     data = json.loads((out / "structure.json").read_text())
@@ -155,6 +156,12 @@ def test_a_structure_run_writes_the_band_of_every_seam(files, tmp_path):
             nominal = band["figures"][f"{panel['name']} {name}"]["nominal"]
             assert nominal == pytest.approx(own[name], abs=1e-9)
     assert band["nominal_difference"] <= 1e-9
+    # the band is the structure's: in its report and structure.json, not in the panels'
+    assert all(name in (out / "report.html").read_text() for name in seams)
+    for panel in data["panels"]:
+        directory = out / panel["directory"]
+        assert "scatter" not in json.loads((directory / "summary.json").read_text())
+        assert "Fabric scatter" not in (directory / "report.html").read_text()
 
 
 def test_a_cut_run_takes_its_strips_as_panels(files, tmp_path):
