@@ -19,11 +19,11 @@ from vares.app.ply_book import ply_book
 from vares.geometry.examples import cap_over_square
 from vares.io.meshes import write_surface
 from vares.io.orientations import read_orientation_csv
-from vares.io.ply_dxf import write_ply_dxf
+from vares.io.ply_dxf import write_ply_dxf, write_ply_nest_dxf
 from vares.materials import NonCrimpFabric
 from vares.options import OptionsError
 from vares.structures.laminate import Ply, PlyOptions, drape_laminate
-from vares.structures.laminate_blanks import ply_blanks
+from vares.structures.laminate_blanks import nest_plies, ply_blanks
 
 NCF = NonCrimpFabric.from_moduli(1000.0, 1000.0, 1.0)
 #: Below the 0° ply's largest shear on this cap (8.2°), above the 45° ply's (5.1°).
@@ -143,6 +143,16 @@ def test_darted_dxf_has_the_dart_lines_on_layer_dart(darted, tmp_path):
     path = tmp_path / "B.dxf"
     write_ply_dxf(path, b, units="mm")
     assert not [e for e in ezdxf.readfile(path).modelspace() if e.dxf.layer == "DART"]
+    # on the roll: each dart placed with its ply
+    nest = nest_plies([a, b], 40.0, time_limit=1.0)
+    write_ply_nest_dxf(tmp_path / "nest.dxf", [a, b], nest, units="mm")
+    space = ezdxf.readfile(tmp_path / "nest.dxf").modelspace()
+    nested = [e for e in space if e.dxf.layer == "DART"]
+    assert len(nested) == len(a.darts)
+    (piece,) = [p for p in nest.pieces if p.index == 0]
+    for line, dart in zip(nested, a.darts, strict=True):
+        drawn = np.array([p[:2] for p in line.get_points()])
+        np.testing.assert_allclose(drawn, piece.place(dart), rtol=0, atol=1e-9)
 
 
 def test_ply_book_shows_the_darts(darted):
@@ -286,11 +296,19 @@ def test_cli_darts_the_plies(tmp_path):
         assert f'id="figure-A-{kind}"' in section
 
 
-def test_plies_on_a_dask_cluster_are_those_draped_here(darted):
+@pytest.mark.parametrize(
+    "cluster_options",
+    [
+        # one worker with two threads in this process: its threads take the plies in turn
+        dict(n_workers=1, threads_per_worker=2, processes=False),
+        # two worker processes: the tasks and their outcomes pickled across
+        dict(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1"),
+    ],
+    ids=["threads", "processes"],
+)
+def test_plies_on_a_dask_cluster_are_those_draped_here(darted, cluster_options):
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
-    ) as cluster:
+    with distributed.LocalCluster(dashboard_address=None, **cluster_options) as cluster:
         remote = drape_laminate(
             mould(),
             plies(),
@@ -300,7 +318,7 @@ def test_plies_on_a_dask_cluster_are_those_draped_here(darted):
             darts="auto",
             locking_angle=LOCKING,
         )
-    assert remote.workers == 1
+    assert remote.workers == cluster_options["n_workers"]
     for name in ("A", "B"):
         here, there = darted.drape(name), remote.drape(name)
         np.testing.assert_array_equal(
