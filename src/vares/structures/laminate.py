@@ -194,7 +194,8 @@ class PlyDrapeResult:
         }
         if self.kinematic is not None:
             data["kinematic_drape"] = self.kinematic.summary()
-            data["kinematic_drape"]["against_pattern"] = self.kinematic.comparison(shear, area)
+            undarted = self.pattern.fields["shear_angle"]  # the net is not darted
+            data["kinematic_drape"]["against_pattern"] = self.kinematic.comparison(undarted, area)
         elif self.kinematic_error is not None:
             data["kinematic_drape"] = {"error": self.kinematic_error}
         data["locking_angle"] = self.locking_angle
