@@ -9,16 +9,23 @@ pattern), every round's tip angle, largest shear, Newton iterations and seconds;
 (``--control``): the last round's dart lines made edges of the mesh but not opened.
 
 Moulds: ``hemisphere`` (``irregular_cap(100, 90, rings, 0.3, 1)``, R = 100 mm to the equator),
-``rib30`` (the shipped rib, warp along the rib); laws: ``ncf`` (the README's non-crimp fabric,
+``rib30`` (the shipped rib, warp along the rib), ``double-dome`` (the shipped double dome,
+``double_dome(cell_size=c)`` for every ``--cell-size c``, warp along x; its kinematic drape from
+the saddle's centre at spacing 2 mm is printed first); laws: ``ncf`` (the README's non-crimp fabric,
 ``NonCrimpFabric([-250, 250], [-250, 250], [0.5])``) and ``woven`` (orthotropic, E/G = 1e4).
 
     python benchmarks/darts.py --rings 20 30 40 --control --picture docs/images
     python benchmarks/darts.py --mould rib30 --locking 50 4
+    python benchmarks/darts.py --mould double-dome --cell-size 5 4 --law ncf woven
+    python benchmarks/darts.py --mould double-dome --radial 35 --law ncf woven
     python benchmarks/darts.py --rings 30 --turned 0 15 30 45 --length 35
 
-(``--turned``: on the hemisphere, four given darts of ``--length`` mm from the equator at the
-45° meridians, each a great circle turned by these angles from the meridian, the same way round
-at every dart, instead of the automatic ones.)
+(``--radial``: on the double dome, four given darts along the rays from the domes' centres
+``(±55, 0)`` at ``±--ray-angle`` (default 36.9°, towards the most sheared cells) to the x-axis,
+from the flange's edge to these plan distances (mm) from the centre. ``--turned``: on the
+hemisphere, four given darts of ``--length`` mm from the equator at the 45° meridians, each a
+great circle turned by these angles from the meridian, the same way round at every dart,
+instead of the automatic ones.)
 """
 
 from __future__ import annotations
@@ -30,8 +37,9 @@ from pathlib import Path
 import numpy as np
 
 from vares.analysis.darts import solve_with_darts
+from vares.analysis.drape import drape_ply
 from vares.geometry.cutting import cut_mesh
-from vares.geometry.examples import irregular_cap, rib30
+from vares.geometry.examples import double_dome, double_dome_height, irregular_cap, rib30
 from vares.geometry.surface_lines import EdgeLocator
 from vares.materials import NonCrimpFabric, OrthotropicStVenantKirchhoff
 
@@ -41,16 +49,38 @@ LAWS = {
 }
 
 
-def mould(name: str, rings: int):
+def mould(name: str, rings: int, cell_size: float = 5.0):
     """The mesh and the warp direction."""
     if name == "hemisphere":
         return irregular_cap(100.0, 90.0, rings, 0.3, 1), (1.0, 0.0, 0.0)
+    if name == "double-dome":
+        return double_dome(cell_size=cell_size), (1.0, 0.0, 0.0)
     return rib30(), (0.0, 1.0, 0.0)
+
+
+def kinematic(mesh, warp, locking: float) -> None:
+    """The kinematic drape from the node nearest the plan's centre: its largest shear, the area
+    at or beyond the locking angle and the share of the area the net reaches."""
+    points = mesh.points
+    seed = points[np.argmin(np.hypot(points[:, 0], points[:, 1]))]
+    clock = time.perf_counter()
+    ply = drape_ply(mesh, seed=tuple(seed), warp=warp, spacing=2.0, locking_angle=locking)
+    check = ply.producibility
+    print(
+        f"\nkinematic drape ({mesh.num_cells} cells, seed {np.round(seed, 2).tolist()}, "
+        f"spacing 2): "
+        f"largest shear {check.max_shear:.2f}°, at or beyond {locking:g}°: "
+        f"{100 * check.fractions['limit']:.2f} % of the {100 * check.covered:.1f} % reached; "
+        f"{time.perf_counter() - clock:.1f} s"
+    )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--mould", choices=("hemisphere", "rib30"), default="hemisphere")
+    parser.add_argument(
+        "--mould", choices=("hemisphere", "rib30", "double-dome"), default="hemisphere"
+    )
+    parser.add_argument("--cell-size", type=float, nargs="+", default=[5.0], help="double dome")
     parser.add_argument("--rings", type=int, nargs="+", default=[30])
     parser.add_argument("--law", choices=tuple(LAWS), nargs="+", default=["ncf"])
     parser.add_argument("--locking", type=float, nargs="+", default=[50.0])
@@ -58,14 +88,25 @@ def main() -> None:
     parser.add_argument("--picture", type=Path, help="folder for darts_<mould>.png")
     parser.add_argument("--turned", type=float, nargs="+", help="given darts turned (degrees)")
     parser.add_argument("--length", type=float, default=35.0, help="their length (mm)")
+    parser.add_argument("--radial", type=float, nargs="+", help="given darts' ends (mm)")
+    parser.add_argument("--ray-angle", type=float, default=36.9, help="their rays (degrees)")
     args = parser.parse_args()
+    if args.radial:
+        for size in args.cell_size:
+            for law in args.law:
+                for end in args.radial:
+                    radial(size, law, args.locking[0], end, args.ray_angle)
+        return
     if args.turned:
         for rings in args.rings:
             turned(rings, args.law[0], args.locking[0], args.turned, args.length)
         return
+    sizes = args.cell_size if args.mould == "double-dome" else [0.0]
     rings_list = args.rings if args.mould == "hemisphere" else [0]
-    for rings in rings_list:
-        mesh, warp = mould(args.mould, rings)
+    for rings, size in ((r, c) for r in rings_list for c in sizes):
+        mesh, warp = mould(args.mould, rings, size)
+        if args.mould == "double-dome":
+            kinematic(mesh, warp, args.locking[0])
         for law in args.law:
             for locking in args.locking:
                 clock = time.perf_counter()
@@ -75,8 +116,8 @@ def main() -> None:
                 total = time.perf_counter() - clock
                 s = darted.summary()
                 print(
-                    f"\n{args.mould} {rings or ''} ({mesh.num_cells} cells), {law}, locking "
-                    f"{locking:g}°: before {s['max_shear_before']:.2f}° "
+                    f"\n{args.mould} {rings or size or ''} ({mesh.num_cells} cells), {law}, "
+                    f"locking {locking:g}°: before {s['max_shear_before']:.2f}° "
                     f"({s['iterations_before']} it, {s['seconds_before']:.1f} s); "
                     f"total {total:.1f} s"
                 )
@@ -100,6 +141,8 @@ def main() -> None:
                             f"{np.round(tip, 2).tolist()}, azimuth "
                             f"{np.degrees(np.arctan2(mouth[1], mouth[0])):.1f}°"
                         )
+                if args.mould == "double-dome":
+                    quadrants(darted)
                 if args.control and darted.after is not None:
                     locate = EdgeLocator(mesh, tolerance=1e-6 * float(np.ptp(mesh.points)))
                     lines = [locate.line(line) for line in darted.dart_lines]
@@ -118,7 +161,7 @@ def main() -> None:
                     from vares.io.dart_plots import plot_darts
 
                     figure = plot_darts(darted)
-                    path = args.picture / f"darts_{args.mould}.png"
+                    path = args.picture / f"darts_{args.mould.replace('-', '_')}.png"
                     figure.savefig(path)
                     plt.close(figure)
                     print(f"  wrote {path}")
@@ -149,6 +192,50 @@ def turned(rings: int, law: str, locking: float, angles: list[float], length: fl
             f"the meridian: before {s['max_shear_before']:.2f}°, after {r['max_shear']:.2f}° "
             f"({r['iterations']} it, converged {r['converged']}); lengths {lengths}; mouths "
             f"{openings}; {time.perf_counter() - clock:.1f} s"
+        )
+
+
+def radial(cell_size: float, law: str, locking: float, end: float, angle: float) -> None:
+    """Given darts on the double dome, along rays from the domes' centres (module docs)."""
+    mesh, warp = mould("double-dome", 0, cell_size)
+    lines = []
+    for sx in (1.0, -1.0):
+        for sy in (1.0, -1.0):
+            ray = np.array([sx * np.cos(np.radians(angle)), sy * np.sin(np.radians(angle))])
+            xy = np.array([55.0 * sx, 0.0]) + np.linspace(end, 120.0, 200)[:, None] * ray
+            xy = xy[(xy[:, 0] / 155.0) ** 2 + (xy[:, 1] / 100.0) ** 2 < 0.999]
+            lines.append(np.column_stack([xy, double_dome_height(xy[:, 0], xy[:, 1])])[::-1])
+    clock = time.perf_counter()
+    darted = solve_with_darts(
+        mesh, LAWS[law](), locking_angle=locking, polylines=lines, warp_direction=warp
+    )
+    s = darted.summary()
+    r = s["rounds"][0]
+    openings = ", ".join(f"{v:.4g}" for v in s["mouth_openings"])
+    lengths = ", ".join(f"{v:.4g}" for v in s["dart_lengths"])
+    print(
+        f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, darts along rays at "
+        f"{angle:g}° to {end:g} mm of the domes' centres: before {s['max_shear_before']:.2f}°, "
+        f"after {r['max_shear']:.2f}° ({r['iterations']} it, converged {r['converged']}); "
+        f"lengths {lengths}; mouths {openings}; {time.perf_counter() - clock:.1f} s"
+    )
+    quadrants(darted)
+
+
+def quadrants(darted) -> None:
+    """The largest shear of every quadrant (signs of x and y) before and after the darts."""
+    for name, result in (("before", darted.before), ("after", darted.after)):
+        if result is None:
+            continue
+        centres = result.mesh.points[result.mesh.cells["triangle"]].mean(axis=1)
+        shear = np.abs(result.fields["shear_angle"])
+        largest = [
+            shear[(np.sign(centres[:, 0]) == sx) & (np.sign(centres[:, 1]) == sy)].max()
+            for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))
+        ]
+        print(
+            f"  {name}: largest shear per quadrant (+,+) (-,+) (-,-) (+,-): "
+            + ", ".join(f"{v:.2f}°" for v in largest)
         )
 
 
