@@ -355,6 +355,7 @@ def run_laminate_job(
     inputs = [job.job.path(p) for p in job.job.input.paths]
     if job.job.location is not None:
         inputs.append(job.job.location)
+    inputs += [job.job.path(p.dart_lines) for p in job.plies if p.dart_lines is not None]
     folder = OutputFolder(
         job.directory, laminate_files(job), force=force, inputs=inputs, command="laminate"
     )
