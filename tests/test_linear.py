@@ -193,3 +193,31 @@ def test_two_solvers_factorise_and_solve_in_turn(name):
         for solver, matrix in zip(solvers, matrices, strict=True):
             rhs = rng.normal(size=matrix.shape[0])
             np.testing.assert_allclose(matrix @ solver.solve(rhs), rhs, atol=1e-10)
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")
+def test_pardiso_solves_in_two_threads_at_once_as_each_alone():
+    """Each thread has its own PARDISO handle (analysis and factors): two solves of different
+    meshes running at once in two threads give exactly the patterns each gives alone (with one
+    handle shared by the process, they overwrote each other's factors, or crashed)."""
+    import threading
+
+    meshes = [examples.hypar(n=n) for n in (20, 23)]
+    material = vares.materials.StVenantKirchhoff(1000.0, 0.3)
+    alone = [vares.solve(m, material, linear_solver="pardiso").material_coordinates for m in meshes]
+    together: list[list[np.ndarray]] = [[], []]
+
+    def work(i: int) -> None:
+        for _ in range(3):
+            result = vares.solve(meshes[i], material, linear_solver="pardiso")
+            together[i].append(result.material_coordinates)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for i in range(2):
+        assert len(together[i]) == 3
+        for coordinates in together[i]:
+            np.testing.assert_array_equal(coordinates, alone[i])

@@ -21,6 +21,7 @@ fastest first (measured in docs/benchmarks.md):
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 from typing import Protocol
 
@@ -34,6 +35,7 @@ __all__ = [
     "LinearSolver",
     "SingularMatrixError",
     "available_solvers",
+    "forget_pardiso_analysis",
     "get_solver",
     "quiet_blas",
     "solver_choice",
@@ -146,15 +148,13 @@ class SuperLUSolver:
 DIAGONAL_PIVOTING_RESIDUAL = 1e-9
 
 
-_PARDISO = None
-
-
 class PardisoSolver:
     """MKL PARDISO, real symmetric indefinite (upper triangle), via pypardiso.
 
     The symbolic analysis (phase 11) is redone only when the sparsity pattern changes; each
-    factorisation is the numeric phase 22 alone. All instances share one PARDISO handle (MKL is
-    loaded once per process), so solvers must not be used from several threads at once.
+    factorisation is the numeric phase 22 alone. The instances of one thread share one PARDISO
+    handle (its analysis and factors, :class:`PardisoState`); each thread has its own, so solves
+    in several threads at once (a Dask worker's threads) do not disturb one another.
 
     Settings (chosen by measurement, docs/benchmarks.md): minimum-degree ordering below
     :data:`NESTED_DISSECTION_ABOVE` unknowns (its analysis is 3× faster and its fill no larger
@@ -168,16 +168,8 @@ class PardisoSolver:
     reuse_iterations = 0
 
     def __init__(self) -> None:
-        global _PARDISO
-        if _PARDISO is None:  # loading MKL takes a while: one handle per process
-            _point_pypardiso_at_mkl()
-            import pypardiso
-
-            _PARDISO = pypardiso.PyPardisoSolver(mtype=-2)
-            _PARDISO.set_statistical_info_off()
-            for index, value in _PARDISO_SETTINGS.items():
-                _PARDISO.iparm[index - 1] = value
-        self._solver = _PARDISO
+        self._state = _pardiso_state()
+        self._solver = self._state.handle
         self._matrix = None
         self._upper = None
 
@@ -214,7 +206,7 @@ class PardisoSolver:
         return x
 
     def factorize(self, matrix: sp.csr_matrix, definite: bool = False) -> None:
-        global _PARDISO_ANALYSED
+        state = self._state
         size = matrix.shape[0]
         if self._upper is None or not _same_pattern(self._upper[0], _pattern(matrix)):
             index, indptr, indices = _upper_triangle_map(matrix)
@@ -227,36 +219,67 @@ class PardisoSolver:
         data = np.append(matrix.data, 0.0)[index]
         self._matrix = sp.csr_matrix((data, indices, indptr), shape=matrix.shape)
         empty = np.zeros(size)
-        if _PARDISO_ANALYSED is None or not _same_pattern(
-            _PARDISO_ANALYSED, _pattern(self._matrix)
-        ):
-            _PARDISO_ANALYSED = None
+        if state.analysed is None or not _same_pattern(state.analysed, _pattern(self._matrix)):
+            state.analysed = None
             self._solver.iparm[1] = 3 if size > NESTED_DISSECTION_ABOVE else 0  # iparm(2)
             self._phase(11, empty)
-            _PARDISO_ANALYSED = _pattern(self._matrix)
+            state.analysed = _pattern(self._matrix)
         self._numeric()
 
     def _numeric(self) -> None:
-        """The numeric factorisation of this solver's matrix into the shared handle."""
-        global _PARDISO_FACTORS
+        """The numeric factorisation of this solver's matrix into the thread's handle."""
         empty = np.zeros(self._matrix.shape[0])
         self._phase(22, empty)
-        _PARDISO_FACTORS = self
+        self._state.factors = self
         if self._solver.iparm[29] != 0:  # iparm(30): a zero pivot
             raise SingularMatrixError("PARDISO found a zero pivot")
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         if self._matrix is None:
             raise RuntimeError("factorize() must be called before solve()")
-        if _PARDISO_FACTORS is not self:  # another solver factorised since: factorise again
-            global _PARDISO_ANALYSED
-            analysed = _PARDISO_ANALYSED
+        state = self._state
+        if state.factors is not self:  # another solver factorised since: factorise again
+            analysed = state.analysed
             if analysed is None or not _same_pattern(analysed, _pattern(self._matrix)):
                 self._solver.iparm[1] = 3 if self._matrix.shape[0] > NESTED_DISSECTION_ABOVE else 0
                 self._phase(11, np.zeros(self._matrix.shape[0]))
-                _PARDISO_ANALYSED = _pattern(self._matrix)
+                state.analysed = _pattern(self._matrix)
             self._numeric()
         return _finite(self._phase(33, np.ascontiguousarray(rhs, dtype=float)))
+
+
+class PardisoState(threading.local):
+    """A thread's PARDISO handle (made when the thread first solves; MKL itself is loaded
+    once per process), the sparsity pattern it has analysed (see :func:`_pattern`) and the
+    solver whose numeric factors it holds (a solver whose matrix was factorised by another
+    since factorises it again before it solves)."""
+
+    handle = None
+    analysed: tuple | None = None
+    factors: PardisoSolver | None = None
+
+
+_PARDISO_STATE = PardisoState()
+
+
+def _pardiso_state() -> PardisoState:
+    state = _PARDISO_STATE
+    if state.handle is None:
+        _point_pypardiso_at_mkl()
+        import pypardiso
+
+        handle = pypardiso.PyPardisoSolver(mtype=-2)
+        handle.set_statistical_info_off()
+        for index, value in _PARDISO_SETTINGS.items():
+            handle.iparm[index - 1] = value
+        state.handle = handle
+    return state
+
+
+def forget_pardiso_analysis() -> None:
+    """Forget the symbolic analysis this thread's PARDISO handle keeps (the next
+    factorisation analyses its matrix afresh, as in a new process)."""
+    _PARDISO_STATE.analysed = None
 
 
 def _point_pypardiso_at_mkl() -> None:
@@ -301,12 +324,6 @@ def _upper_triangle_map(matrix: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, 
 _PARDISO_SETTINGS = {1: 1, 2: 0, 8: 0, 10: 8, 11: 0, 13: 0, 21: 1}
 #: PARDISO orders by parallel nested dissection above this many unknowns, else minimum degree.
 NESTED_DISSECTION_ABOVE = 600_000
-
-#: The sparsity pattern the shared PARDISO handle has analysed (see :func:`_pattern`).
-_PARDISO_ANALYSED: tuple | None = None
-#: The solver whose numeric factors the shared handle holds (a solver whose matrix was
-#: factorised by another since factorises it again before it solves).
-_PARDISO_FACTORS: PardisoSolver | None = None
 
 
 def _pattern(matrix: sp.csr_matrix) -> tuple:
