@@ -156,3 +156,12 @@ def test_the_drape_command_drapes_the_shipped_part(tmp_path, mould):
     expected = direct.producibility.fractions["limit"]
     assert data["producibility"]["limit_fraction"] == pytest.approx(expected, rel=1e-6)
     assert data["producibility"]["limit_fraction"] > 0.02
+
+
+def test_the_example_command_refuses_quads_in_one_line(tmp_path):
+    from conftest import error_line, run
+
+    result = run("example", "double-dome", "--cell-type", "quad", "-o", tmp_path / "out", "-q")
+    assert result.exit_code == 2
+    assert "the double dome is meshed with irregular triangles only" in error_line(result)
+    assert not (tmp_path / "out").exists()
