@@ -299,7 +299,7 @@ def test_cli_darts_the_plies(tmp_path):
 @pytest.mark.parametrize(
     "cluster_options",
     [
-        # one worker with two threads in this process: its threads take the plies in turn
+        # one worker with two threads in this process: its threads drape plies at once
         dict(n_workers=1, threads_per_worker=2, processes=False),
         # two worker processes: the tasks and their outcomes pickled across
         dict(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1"),

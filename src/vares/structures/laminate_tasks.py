@@ -19,7 +19,6 @@ value where the cell is whole.
 from __future__ import annotations
 
 import hashlib
-import threading
 import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
@@ -38,13 +37,7 @@ from .laminate_options import LaminateOptions, PlyOptions
 if TYPE_CHECKING:
     from .laminate import Ply
 
-#: One ply is solved at a time in a process: two solves in threads of one process (a Dask worker
-#: with several threads) do not give the patterns they give alone (measured: every coordinate
-#: differed), so a worker's threads take the ply tasks in turn.
-SOLVE_LOCK = threading.Lock()
-
 __all__ = [
-    "SOLVE_LOCK",
     "dart_task",
     "darts_used",
     "drape_key",
@@ -58,10 +51,10 @@ __all__ = [
 def drape_task(task: dict[str, Any]) -> dict[str, Any]:
     """Drape one distinct ply (in any process): the pattern of its mesh, with its darts when
     asked (``task["darts"]``: ``None``, or the keywords of the locking angle, the dart mode and
-    given lines), and the kinematic net beside it (its failure is reported, not raised); under
-    :data:`SOLVE_LOCK`."""
-    with SOLVE_LOCK:
-        return _drape(task)
+    given lines), and the kinematic net beside it (its failure is reported, not raised). Plies
+    may be draped in several threads of one process at once (a Dask worker's threads): each
+    thread solves with its own linear solver (:class:`vares.solver.linear.PardisoState`)."""
+    return _drape(task)
 
 
 def _drape(task: dict[str, Any]) -> dict[str, Any]:
