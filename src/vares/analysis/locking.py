@@ -117,7 +117,7 @@ def solve_yarn_strain(
     for stage_ratio in [*ratios, None]:
         law = material if stage_ratio is None else ScaledYarns(material, stage_ratio / ratio)
         scale = 1.0 if stage_ratio is None else ratio / stage_ratio
-        share = min(yarn_stabilisation * scale, 0.5) if yarn_stabilisation else 0.0
+        share = yarn_stabilisation if stage_ratio is None else min(yarn_stabilisation * scale, 0.5)
         shown = ratio if stage_ratio is None else stage_ratio
         aligned = direction is not None and (align_up_to is None or shown <= align_up_to)
         stage_options = base.replace(yarn_stabilisation=share)
