@@ -122,8 +122,9 @@ def test_refined_start_is_the_start_where_the_step_folds():
     assert arap_refined(mesh, start) is start
 
 
-def test_no_refinement_unless_isotropic_or_for_pseudo_time():
+def test_no_refinement_unless_isotropic_nor_for_pseudo_time_or_a_named_plane():
     mesh = vares.examples.spherical_cap()
     assert initial_guess(mesh, SolveOptions()).refinement == ""
+    assert initial_guess(mesh, SolveOptions(plane="xy"), isotropic=True).refinement == ""
     pseudo = initial_guess(mesh, SolveOptions(strategy="pseudo-time"), isotropic=True)
     assert pseudo.refinement == "" and pseudo.kind == "projection"

@@ -83,7 +83,8 @@ def initial_guess(
 
     ``isotropic``: the energy does not depend on the pattern's rotation (an isotropic law, no
     prestress); the automatic start is then refined by :func:`arap_refined` (not for
-    pseudo-time stepping, whose path starts from the projection itself).
+    pseudo-time stepping, whose path starts from the projection itself, nor where a plane is
+    named: its projection is the start asked for).
     """
     if given is not None:
         return _given(mesh, options, given)
@@ -91,7 +92,7 @@ def initial_guess(
     if options.initial_guess != "auto":
         return _make(mesh, options.initial_guess, plane)
     start = _automatic(mesh, options, plane)
-    if isotropic and options.strategy != "pseudo-time":
+    if isotropic and options.strategy != "pseudo-time" and not options.named_plane:
         return arap_refined(mesh, start, solver=get_solver(options.linear_solver))
     return start
 
