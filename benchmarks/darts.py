@@ -10,8 +10,9 @@ pattern), every round's tip angle, largest shear, Newton iterations and seconds;
 
 Moulds: ``hemisphere`` (``irregular_cap(100, 90, rings, 0.3, 1)``, R = 100 mm to the equator),
 ``rib30`` (the shipped rib, warp along the rib), ``double-dome`` (the shipped double dome,
-``double_dome(cell_size=c)`` for every ``--cell-size c``, warp along x; its kinematic drape from
-the saddle's centre at spacing 2 mm is printed first); laws: ``ncf`` (the README's non-crimp fabric,
+``double_dome(cell_size=c)`` for every ``--cell-size c``, warp along x; its kinematic drape at
+spacing 2 mm from the saddle's centre, the node nearest it and points beside it is printed
+first, ``--kinematic``: only that); laws: ``ncf`` (the README's non-crimp fabric,
 ``NonCrimpFabric([-250, 250], [-250, 250], [0.5])``) and ``woven`` (orthotropic, E/G = 1e4).
 
     python benchmarks/darts.py --rings 20 30 40 --control --picture docs/images
@@ -59,15 +60,29 @@ def mould(name: str, rings: int, cell_size: float = 5.0):
 
 
 def kinematic(mesh, warp, locking: float) -> None:
-    """The kinematic drape from the node nearest the plan's centre: its largest shear, the area
-    at or beyond the locking angle and the share of the area the net reaches."""
+    """The kinematic drape from the saddle's centre (on both planes of symmetry): its largest
+    shear, the area at or beyond the locking angle and the share of the area the net reaches;
+    then from the node nearest it, and from points 0.01 and 0.1 mm beside it."""
+    centre = np.array([0.0, 0.0, float(double_dome_height(np.zeros(1), np.zeros(1))[0])])
     points = mesh.points
-    seed = points[np.argmin(np.hypot(points[:, 0], points[:, 1]))]
+    node = points[np.argmin(np.hypot(points[:, 0], points[:, 1]))]
+    for seed in (
+        centre,
+        node,
+        centre + np.array([0.01, 0.0, 0.0]),
+        centre + np.array([0.0, 0.01, 0.0]),
+        centre + np.array([0.1, 0.1, 0.0]),
+    ):
+        kinematic_from(mesh, seed, warp, locking)
+
+
+def kinematic_from(mesh, seed: np.ndarray, warp, locking: float) -> None:
+    """The kinematic drape from ``seed`` (see :func:`kinematic`)."""
     clock = time.perf_counter()
     ply = drape_ply(mesh, seed=tuple(seed), warp=warp, spacing=2.0, locking_angle=locking)
     check = ply.producibility
     print(
-        f"\nkinematic drape ({mesh.num_cells} cells, seed {np.round(seed, 2).tolist()}, "
+        f"\nkinematic drape ({mesh.num_cells} cells, seed {np.round(seed, 4).tolist()}, "
         f"spacing 2): "
         f"largest shear {check.max_shear:.2f}°, at or beyond {locking:g}°: "
         f"{100 * check.fractions['limit']:.2f} % of the {100 * check.covered:.1f} % reached; "
@@ -81,6 +96,7 @@ def main() -> None:
         "--mould", choices=("hemisphere", "rib30", "double-dome"), default="hemisphere"
     )
     parser.add_argument("--cell-size", type=float, nargs="+", default=[5.0], help="double dome")
+    parser.add_argument("--kinematic", action="store_true", help="double dome: the net only")
     parser.add_argument("--rings", type=int, nargs="+", default=[30])
     parser.add_argument("--law", choices=tuple(LAWS), nargs="+", default=["ncf"])
     parser.add_argument("--locking", type=float, nargs="+", default=[50.0])
@@ -107,6 +123,8 @@ def main() -> None:
         mesh, warp = mould(args.mould, rings, size)
         if args.mould == "double-dome":
             kinematic(mesh, warp, args.locking[0])
+            if args.kinematic:
+                continue
         for law in args.law:
             for locking in args.locking:
                 clock = time.perf_counter()

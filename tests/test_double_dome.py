@@ -116,17 +116,20 @@ def test_bad_dimensions_are_refused(settings, message):
         double_dome(**settings)
 
 
+#: The saddle's centre, on both planes of symmetry: the seed of a symmetric drape.
+CENTRE = (0.0, 0.0, float(double_dome_height(np.zeros(1), np.zeros(1))[0]))
+
+
 def test_the_kinematic_drape_exceeds_the_locking_angle_on_all_four_walls(mould):
-    points = mould.points
-    seed = points[np.argmin(np.hypot(points[:, 0], points[:, 1]))]
-    ply = drape_ply(mould, seed=tuple(seed), warp=(1.0, 0.0, 0.0), spacing=2.0)
+    ply = drape_ply(mould, seed=CENTRE, warp=(1.0, 0.0, 0.0), spacing=2.0)
     shear = np.abs(ply.drape.shear_angle)
+    # 56.9° and 4.7 % as measured (docs/composites.md); the net's largest shear lies where it
+    # stops and moves by several degrees with the seed moved by 0.1 mm, its area beyond 50° by
+    # about one percent of the part: hence the wide bounds
     assert ply.producibility.max_shear > 55.0
     assert 0.02 < ply.producibility.fractions["limit"] < 0.1
-    # each of the four symmetric dome walls (quadrants) is sheared to near or beyond 50°: the
-    # largest shear of a quadrant lies where the net stops, and moves by a few degrees with the
-    # seed point moved by a fraction of a millimetre
-    centres = points[mould.cells["triangle"]].mean(axis=1)
+    # each of the four symmetric dome walls (quadrants) is sheared to near or beyond 50°
+    centres = mould.points[mould.cells["triangle"]].mean(axis=1)
     for sx in (1, -1):
         for sy in (1, -1):
             quadrant = (np.sign(centres[:, 0]) == sx) & (np.sign(centres[:, 1]) == sy)
@@ -143,8 +146,7 @@ def test_the_drape_command_drapes_the_shipped_part(tmp_path, mould):
     surface = tmp_path / "double-dome.obj"
     write_surface(surface, mould)
     out = tmp_path / "out"
-    seed = mould.points[np.argmin(np.hypot(mould.points[:, 0], mould.points[:, 1]))]
-    seed_flag = ",".join(f"{v:.6f}" for v in seed)
+    seed_flag = ",".join(f"{v:.6f}" for v in CENTRE)
     result = run(
         "drape", surface, "--seed", seed_flag, "--warp", "1,0,0", "--spacing", 2, "-o", out
     )
