@@ -47,7 +47,7 @@ def run_vares(mesh, solver: str | None, material: str = "stvk") -> tuple[float, 
     import vares
     from vares.solver import linear
 
-    linear._PARDISO_ANALYSED = None  # from scratch: no symbolic analysis kept from a run before
+    linear.forget_pardiso_analysis()  # from scratch: no symbolic analysis kept from a run before
     law = vares.materials.StVenantKirchhoff if material == "stvk" else vares.materials.NeoHooke
     points, cells = mesh.points.copy(), {k: v.copy() for k, v in mesh.cells.items()}
     start = time.perf_counter()
