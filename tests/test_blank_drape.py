@@ -197,6 +197,30 @@ def test_cli_drape_blank_writes_its_files(tmp_path):
     assert alone.exit_code == 2 and "--blank-width" in error_line(alone)
 
 
+def test_cli_drape_blank_refuses_a_zero_spacing_and_a_blank_too_fine(tmp_path):
+    from vares.io.meshes import write_surface
+
+    mould = tmp_path / "plate.vtu"
+    write_surface(mould, plate())
+    fabric = ["--material", "orthotropic", "--E1", "1000", "--E2", "1000", "--G12", "10"]
+    fabric += ["--nu12", "0"]
+    blank = ["--blank-length", 140, "--blank-width", 80]
+    zero = run("drape-blank", mould, *blank, "--spacing", 0, *fabric, "-o", tmp_path / "a")
+    assert zero.exit_code == 2 and "--spacing must be > 0; got 0" in error_line(zero)
+    huge = ["--blank-length", "1e6", "--blank-width", "1e6", "--spacing", 4]
+    fine = run("drape-blank", mould, *huge, *fabric, "-o", tmp_path / "b")
+    assert fine.exit_code == 2, fine.stderr
+    assert "62,500,500,001 nodes" in error_line(fine) and "larger spacing" in error_line(fine)
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_a_blank_of_too_many_nodes_is_refused_before_it_is_meshed():
+    with pytest.raises(ValueError, match="4,004,001 nodes"):
+        rectangle_blank(2000.0, 2000.0, 1.0)
+    with pytest.raises(ValueError, match="nodes"):
+        outline_blank(np.array([[0, 0], [2000, 0], [2000, 2000], [0, 2000.0]]), 1.0)
+
+
 def test_blank_outline_from_dxf_and_the_cutting_drawing(tmp_path):
     import ezdxf
 

@@ -15,7 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Blank", "outline_blank", "rectangle_blank"]
+__all__ = ["MAX_BLANK_NODES", "Blank", "outline_blank", "rectangle_blank"]
+
+MAX_BLANK_NODES = 1_000_000
+"""The most nodes a blank's grid may have: a blank finer than this is refused before it is
+meshed (its drape would take hours; the grid alone would fill the memory long before)."""
 
 
 @dataclass(frozen=True)
@@ -56,6 +60,7 @@ def rectangle_blank(length: float, width: float, spacing: float) -> Blank:
         )
     nx = 2 * max(1, round(length / (2 * spacing)))
     ny = 2 * max(1, round(width / (2 * spacing)))
+    _check_size((nx + 1) * (ny + 1), length, width, spacing)
     x = np.linspace(-length / 2, length / 2, nx + 1)
     y = np.linspace(-width / 2, width / 2, ny + 1)
     grid = np.stack(np.meshgrid(x, y, indexing="ij"), axis=-1).reshape(-1, 2)
@@ -114,6 +119,7 @@ def outline_blank(
         )
         for k in range(2)
     )
+    _check_size(len(i) * len(j), *(high - low), spacing)
     grid = centre + spacing * np.stack(np.meshgrid(i, j, indexing="ij"), axis=-1).reshape(-1, 2)
     keep = contains_xy(polygon, grid[:, 0], grid[:, 1])
     grid = grid[keep]
@@ -132,6 +138,14 @@ def outline_blank(
     renumber[used] = np.arange(len(used))
     seed_node = int(renumber[np.count_nonzero(clear[:seed_row])])
     return Blank(nodes[used], renumber[triangles], seed_node, ring)
+
+
+def _check_size(nodes: int, length: float, width: float, spacing: float) -> None:
+    if nodes > MAX_BLANK_NODES:
+        raise ValueError(
+            f"a blank of {length:g} × {width:g} at spacing {spacing:g} would have {nodes:,} nodes "
+            f"(at most {MAX_BLANK_NODES:,}): give a larger spacing"
+        )
 
 
 def _densified(ring: np.ndarray, spacing: float) -> np.ndarray:

@@ -97,13 +97,16 @@ def drape_blank(
         else:
             points = mesh.points
             seed = points[np.argmin(np.linalg.norm(points - points.mean(axis=0), axis=1))]
+        spacing = values["spacing"]
+        if spacing is not None and not spacing > 0:
+            raise InputError(f"--spacing must be > 0; got {spacing:g}")
         if rectangle:
             length, width = values["blank_length"], values["blank_width"]
-            spacing = values["spacing"] or max(length, width) / 50.0
+            spacing = spacing or max(length, width) / 50.0
             blank = rectangle_blank(length, width, spacing)
         else:
             ring = read_blank_outline(values["blank_dxf"], values["blank_layer"])
-            spacing = values["spacing"] or float(np.ptp(ring, axis=0).max()) / 50.0
+            spacing = spacing or float(np.ptp(ring, axis=0).max()) / 50.0
             blank = outline_blank(ring, spacing)
         if values["flange"] is not None and values["flange"] < 0:
             raise InputError(f"--flange must not be negative; got {values['flange']}")
