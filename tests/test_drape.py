@@ -368,6 +368,19 @@ def test_bad_input_is_refused():
         kinematic_net(mesh, [0, 0, R], [1, 0, 0], 0.0)
 
 
+def test_a_warp_nearly_normal_to_the_mould_is_refused():
+    # On irregular triangles the pole's normal tilts by about 0.1°: a warp along z would take
+    # its direction from that tilt alone.
+    mesh = irregular_cap(R, 90.0, 20, 0.3, 1)
+    for warp in ([0, 0, 1], [0.05, 0, 1]):  # 0° and 2.9° from the normal
+        with pytest.raises(DrapeError, match="within 5° of the mould's normal"):
+            kinematic_net(mesh, [0, 0, R], warp, 4.0)
+    net = kinematic_net(mesh, [0, 0, R], [0.2, 0, 1], 4.0)  # 11.3° from it: the warp is +x
+    si, sj = net.seed
+    step = net.positions[si + 1, sj] - net.positions[si, sj]
+    assert step[0] / np.linalg.norm(step) > 0.99
+
+
 # ---------------------------------------------------------------------------- producibility
 
 

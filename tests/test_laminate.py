@@ -279,6 +279,20 @@ def test_a_ply_with_its_own_seed_is_draped_from_there():
     assert result.converged
 
 
+def test_a_ply_seed_off_the_mould_is_refused():
+    from vares.geometry.drape import DrapeError
+
+    mesh = mould()
+    top = mesh.points[np.argmax(mesh.points[:, 2])]
+    above = tuple(top + np.array([0, 0, 50.0]))  # 50 above the cap (10 wide)
+    plies = [Ply(PlyOptions(name="P1", orientation=0.0, seed=above), NCF)]
+    with pytest.raises(DrapeError, match=r"ply 'P1': the seed .* is not on the mould"):
+        drape_laminate(mesh, plies, workers=1, kinematic=False)
+    with pytest.raises(DrapeError, match=r"the laminate: the seed .* is not on the mould"):
+        drape_laminate(mesh, [Ply(PlyOptions(name="P1"), NCF)], seed=tuple(top + 50.0),
+                       workers=1, kinematic=False)  # fmt: skip
+
+
 def test_abaqus_names_are_labels_and_unique():
     from vares.io.orientations import abaqus_name
 

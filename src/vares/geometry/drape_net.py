@@ -31,7 +31,20 @@ from .mesh import SurfaceMesh
 from .surface_lines import triangulated
 from .surface_points import FaceLocator, barycentric, face_neighbours
 
-__all__ = ["DrapeError", "KinematicNet", "chord_nodes", "kinematic_net", "yarn_shear"]
+__all__ = [
+    "NORMAL_CONE",
+    "DrapeError",
+    "KinematicNet",
+    "chord_nodes",
+    "kinematic_net",
+    "locate_seed",
+    "yarn_shear",
+]
+
+NORMAL_CONE = 5.0
+"""Degrees: a warp (or reference) direction this close to the mould's normal at the seed is
+refused. Its projection onto the tangent plane would be set by the facets' tilt there (about
+0.1° at the pole of an irregular hemisphere), not by the direction given."""
 
 
 class DrapeError(ValueError):
@@ -158,16 +171,16 @@ def kinematic_net(
     triangles = tri_mesh.cells["triangle"]
     locator = FaceLocator(tri_mesh)
     size = float(np.linalg.norm(np.ptp(tri_mesh.points, axis=0)))
-    seed = np.asarray(seed, dtype=float).reshape(3)
-    face, bary, seed_point = (a[0] for a in locator.locate(seed[None]))
-    reach = np.ptp(tri_mesh.points[triangles[face]], axis=0).max()
-    if np.linalg.norm(seed_point - seed) > reach:
-        raise DrapeError(f"the seed {seed} is not on the mould (nearest point {seed_point})")
+    face, bary, seed_point = locate_seed(tri_mesh, seed, locator)
     normal, vertex = _seed_normal(tri_mesh, face, bary, size)
     warp = np.asarray(warp_direction, dtype=float).reshape(3)
+    length = float(np.linalg.norm(warp))
     warp = warp - (warp @ normal) * normal
-    if np.linalg.norm(warp) < 1e-9 * max(1.0, float(np.linalg.norm(warp_direction))):
-        raise DrapeError("the warp direction is normal to the mould at the seed")
+    if not np.linalg.norm(warp) > np.sin(np.radians(NORMAL_CONE)) * length:
+        raise DrapeError(
+            f"the warp direction is within {NORMAL_CONE:g}° of the mould's normal at the seed "
+            f"({np.round(normal, 4).tolist()}): it gives no direction along the mould"
+        )
     warp /= np.linalg.norm(warp)
     fill = np.cross(normal, warp)
     if generators is None:
@@ -195,6 +208,26 @@ def kinematic_net(
     steps = 64 + 8 * int(np.ceil(spacing / edge))  # a walk crosses about spacing / edge faces
     _march(positions, faces, (si, sj), spacing, corners, triangles, steps)
     return KinematicNet(positions, faces, (si, sj), float(spacing))
+
+
+def locate_seed(
+    mesh: SurfaceMesh, seed: np.ndarray, locator: FaceLocator | None = None
+) -> tuple[int, np.ndarray, np.ndarray]:
+    """The triangle, barycentric coordinates ``(3,)`` and nearest point ``(3,)`` of ``seed``
+    ``(3,)`` on the triangulated mould ``mesh`` (``locator``: its :class:`FaceLocator`, built if
+    not given). Raises :class:`DrapeError` when the seed lies farther from the mould than the
+    size of the triangle nearest it."""
+    mesh = triangulated(mesh)
+    locator = FaceLocator(mesh) if locator is None else locator
+    seed = np.asarray(seed, dtype=float).reshape(3)
+    if not np.isfinite(seed).all():
+        raise DrapeError(f"the seed must be three finite numbers; got {seed.tolist()}")
+    face, bary, point = (a[0] for a in locator.locate(seed[None]))
+    reach = np.ptp(mesh.points[mesh.cells["triangle"][face]], axis=0).max()
+    if np.linalg.norm(point - seed) > reach:
+        where, nearest = (", ".join(f"{v:.6g}" for v in p) for p in (seed, point))
+        raise DrapeError(f"the seed ({where}) is not on the mould (nearest point ({nearest}))")
+    return int(face), bary, point
 
 
 def _seed_normal(mesh: SurfaceMesh, face: int, bary: np.ndarray, size: float):

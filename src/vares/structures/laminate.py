@@ -40,7 +40,7 @@ from ..options import OptionsError, split_settings, takes_options
 from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
 from .laminate_pairs import PAIR_VALUES, PairCheck, blank_used_for, draped_yarns, pair_check
-from .laminate_regions import cell_blocks, ply_warp, region_cells, submesh
+from .laminate_regions import cell_blocks, ply_warp, region_cells, seed_on_mould, submesh
 from .laminate_tasks import (
     dart_task,
     darts_used,
@@ -309,6 +309,7 @@ def drape_laminate(
     solve_options = dict(solve_settings or {})
     solve_options.pop("warp_direction", None)
     points = mesh.points
+    seed_on_mould(mesh, options.seed, "the laminate")
     default_seed = (
         np.asarray(options.seed, dtype=float)
         if options.seed is not None
@@ -329,6 +330,7 @@ def drape_laminate(
         else:
             seed = default_seed
         sub, nodes = submesh(mesh, cells)
+        seed_on_mould(sub, o.seed, f"ply {o.name!r}")
         darts = dart_task(ply, options, sub)
         key = drape_key(ply, seed, cells, darts)
         ply_drape[o.name] = key

@@ -3,15 +3,16 @@ their mesh, and the ply's warp at its seed."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from ..geometry.drape_net import NORMAL_CONE, DrapeError, locate_seed
 from ..geometry.mesh import SurfaceMesh
 from ..options import OptionsError
 from .laminate_options import PlyOptions
 
-__all__ = ["cell_blocks", "ply_warp", "region_cells", "submesh"]
+__all__ = ["cell_blocks", "ply_warp", "region_cells", "seed_on_mould", "submesh"]
 
 
 def ply_warp(
@@ -29,14 +30,28 @@ def ply_warp(
     normal /= np.linalg.norm(normal)
     reference = np.asarray(reference, dtype=float)
     tangent = reference - (reference @ normal) * normal
-    if np.linalg.norm(tangent) < 1e-6 * np.linalg.norm(reference):
+    if not np.linalg.norm(tangent) > np.sin(np.radians(NORMAL_CONE)) * np.linalg.norm(reference):
         raise OptionsError(
-            "reference", "is normal to the mould at the seed: it gives no direction there"
+            "reference",
+            f"is within {NORMAL_CONE:g}° of the mould's normal at the seed: it gives no "
+            "direction there",
         )
     tangent /= np.linalg.norm(tangent)
     angle = np.radians(orientation)
     warp = np.cos(angle) * tangent + np.sin(angle) * np.cross(normal, tangent)
     return warp / np.linalg.norm(warp), normal
+
+
+def seed_on_mould(mesh: SurfaceMesh, seed: Sequence[float] | None, name: str) -> None:
+    """Raise :class:`DrapeError`, naming ``name`` (the ply or the laminate), when a given
+    ``seed`` ``(3,)`` lies off the mould ``mesh`` (:func:`locate_seed`): a seed far from it would
+    otherwise be moved silently to the nearest node. ``None`` (no seed given) passes."""
+    if seed is None:
+        return
+    try:
+        locate_seed(mesh, seed)
+    except DrapeError as exc:
+        raise DrapeError(f"{name}: {exc}") from None
 
 
 def region_cells(
