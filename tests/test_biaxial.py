@@ -160,6 +160,13 @@ def test_a_pattern_compensated_by_the_measured_values():
     report = compensation_report(result)
     assert report.warp.compensation_mean == pytest.approx(100 * warp / (1 + warp), rel=1e-7)
     assert report.fill.compensation_mean == pytest.approx(100 * fill / (1 + fill), rel=1e-7)
+    # and the erection says so: erected, the pattern is stretched by exactly 1 + ε onto the
+    # design (an affine map from the pattern to the erected panel, the shape not moved)
+    erected = vares.erect(result)
+    assert erected.converged and erected.deviation()["max"] < 1e-12
+    pattern = np.column_stack([result.material_coordinates, np.ones(mesh.num_points)])
+    stretch, *_ = np.linalg.lstsq(pattern, erected.erected_points[:, :2], rcond=None)
+    np.testing.assert_allclose(stretch[:2].T, np.diag([1 + warp, 1 + fill]), atol=1e-12)
     # the fitted law of the same fabric predicts its own compensation, also exactly
     fitted = OrthotropicStVenantKirchhoff(600.0, 450.0, 30.0, 0.35)
     predicted = law_compensation(fitted, prestress)
