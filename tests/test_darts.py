@@ -312,3 +312,20 @@ def test_no_dart_where_none_is_needed():
     assert darted.summary()["darts"] == 0
     with pytest.raises(ValueError, match="dart_lines names a file"):
         solve_with_darts(cap, law, locking_angle=LOCKING, dart_lines="darts.txt")
+
+
+def test_a_pattern_that_did_not_converge_gets_no_darts_and_says_so():
+    from vares.app.cli.drape import darts_verdict
+    from vares.materials import NonCrimpFabric
+
+    cap = irregular_cap(R, 90.0, 10, 0.3, 1)
+    law = NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5])
+    stopped = solve_with_darts(cap, law, locking_angle=LOCKING, darts="auto", max_iterations=1)
+    assert not stopped.before.converged and stopped.after is None and stopped.rounds == []
+    line = darts_verdict(stopped)
+    assert line.startswith("the pattern without darts did NOT converge (") and "no dart" in line
+    assert "no dart needed" not in line
+    done = solve_with_darts(cap, law, locking_angle=LOCKING, darts="none")
+    assert done.before.converged
+    assert darts_verdict(done).endswith("NOT below the locking angle (0 solves with darts)")
+    assert "no dart placed" in darts_verdict(done)  # beyond the locking angle, none asked for

@@ -16,7 +16,7 @@ from .common import console, guarded
 from .flags import InputError, build, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
-__all__ = ["drape"]
+__all__ = ["darts_verdict", "drape"]
 
 OUTPUT_FLAGS = [
     option_parameter(
@@ -201,12 +201,30 @@ def _show_darts(darted) -> None:
     ):
         table.add_row(str(k), f"{length:.4g}", f"{opening:.4g}")
     console.print(table)
+    console.print(darts_verdict(darted))
+
+
+def darts_verdict(darted) -> str:
+    """The line ``vares drape --darts`` prints of a :class:`~vares.analysis.darts.DartedPattern`:
+    the largest shear without and with the darts against the locking angle, or that the pattern
+    without darts did not converge (then no dart is placed)."""
+    summary = darted.summary()
+    before = summary["max_shear_before"]
+    if not darted.before.converged:
+        return (
+            f"the pattern without darts did NOT converge ({darted.before.reason}): no darts "
+            f"placed (its largest shear {before:.2f}° is not a result)"
+        )
     after = summary["max_shear_after"]
-    tail = "no dart needed" if after is None else f"{after:.2f}° with the darts open"
+    if after is None:
+        tail = "no dart needed" if before < darted.locking_angle else "no dart placed"
+    else:
+        tail = f"{after:.2f}° with the darts open"
     state = "below" if darted.relieved else "NOT below"
-    console.print(
-        f"largest shear of the pattern {summary['max_shear_before']:.2f}° without darts, {tail}: "
-        f"{state} the locking angle ({len(darted.rounds)} solves with darts)"
+    solves = len(darted.rounds)
+    return (
+        f"largest shear of the pattern {before:.2f}° without darts, {tail}: {state} the "
+        f"locking angle ({solves} {'solve' if solves == 1 else 'solves'} with darts)"
     )
 
 
