@@ -31,6 +31,7 @@ __all__ = [
     "check_nest",
     "clearance_of",
     "nest_pieces",
+    "single_precision_step",
     "usable_width",
 ]
 
@@ -104,6 +105,16 @@ def usable_width(roll_width: float) -> float:
     return roll_width * (1.0 - 8.0 * _CLEARANCE)
 
 
+def single_precision_step(outlines: Sequence[np.ndarray], roll_width: float) -> float:
+    """Twice the spacing of single-precision numbers at the farthest a nest of ``outlines``
+    ``(k_i, 2)`` can reach along the roll (their lengths laid end to end): the search places
+    pieces in single precision, so far along a long roll its pieces are that much off the
+    places it checked (the form-found sail's 91 strips at 2.5 m: 2.6 km of roll, two pieces
+    overlapping by 5e-5 m where the clearance is 5e-5 m)."""
+    reach = roll_width + sum(float(np.ptp(np.asarray(o)[:, 0])) for o in outlines)
+    return 2.0 * float(np.spacing(np.float32(reach)))
+
+
 def nest_pieces(
     outlines: Sequence[np.ndarray],
     roll_width: float,
@@ -140,15 +151,18 @@ def nest_pieces(
         )
         for index, (shape, offset) in enumerate(zip(shapes, offsets, strict=True))
     ]
+    # pieces kept a further single-precision step apart; the strip widened by as much at
+    # either edge, since the search keeps the pieces' separation to its edges too
+    extra = single_precision_step(shapes, roll_width)
     instance = spyrrow.StripPackingInstance(
-        "roll", strip_height=roll_width - 2 * clearance, items=items
+        "roll", strip_height=roll_width - 2 * clearance + 2 * extra, items=items
     )
     config = spyrrow.StripPackingConfig(
         early_termination=True,
         total_computation_time=None,
         exploration_time=max(1, round(_EXPLORATION * config_seconds)),
         compression_time=max(1, round(_COMPRESSION * config_seconds)),
-        min_items_separation=gap + clearance,
+        min_items_separation=gap + clearance + extra,
         num_workers=1,
         seed=seed,
     )
@@ -160,7 +174,8 @@ def nest_pieces(
         moved = NestedPiece(index, rotation, np.zeros(2))
         turned_offset = moved.place(-offsets[index][None])[0]
         translation = np.array(placed.translation, dtype=float) + turned_offset
-        pieces.append(NestedPiece(index, rotation, translation + np.array([0.0, clearance])))
+        translation += [0.0, clearance - extra]
+        pieces.append(NestedPiece(index, rotation, translation))
     pieces.sort(key=lambda p: p.index)
     placed_shapes = [Polygon(p.place(shapes[p.index])) for p in pieces]
     start = min(s.bounds[0] for s in placed_shapes)
