@@ -355,6 +355,20 @@ def test_cli_prints_the_plies_and_the_yield(job_run, tmp_path):
     assert again.exit_code == 2 and "--force" in error_line(again)
 
 
+def test_cli_does_not_list_a_nest_it_did_not_write(job_run, tmp_path):
+    _, out = job_run
+    folder = out.parent
+    (folder / "narrow.toml").write_text(
+        job_text().replace("roll_width = 30.0", "roll_width = 5.0"), encoding="utf-8"
+    )
+    done = run("laminate", folder / "narrow.toml", "-o", tmp_path / "narrow")
+    assert done.exit_code == 0, done.stderr
+    assert "not nested: ply P1 is" in done.stderr and "roll_width of 5" in done.stderr
+    assert not (tmp_path / "narrow" / "nest.dxf").exists()
+    assert "nest.dxf" not in done.stderr
+    assert f"wrote {tmp_path / 'narrow' / 'plybook.html'}" in done.stderr
+
+
 def test_ply_book_without_weights_or_roll_says_so(laminate, blanks):
     from dataclasses import replace
 

@@ -95,7 +95,8 @@ def laminate(
             _show(result)
             _show_cutting(run)
             for path in laminate_files(job, result.labels):
-                console.print(f"  wrote {path}")
+                if path.name != "nest.dxf" or run.nest is not None:  # not nested: not written
+                    console.print(f"  wrote {path}")
         if not result.converged:
             raise typer.Exit(1)
 
