@@ -239,6 +239,20 @@ def test_pieces_far_along_a_long_roll_keep_the_search_precision_apart():
     assert bounds[:, 1].min() >= 0 and bounds[:, 3].max() <= 1.0
 
 
+def test_a_roll_too_narrow_for_the_surface_is_refused_before_it_is_refined():
+    from vares.geometry.example_surfaces import tent_roof
+    from vares.structures.layout import MAX_REFINED_CELLS, refined_cells
+
+    tent = triangulated(tent_roof())  # all round: its strips are counted only once refined
+    size = np.ptp(tent.points, axis=0).max()
+    edge = longest_edge(tent)
+    assert refined_cells(tent, 2.0 * edge) == tent.num_cells  # no cell needs a split
+    assert refined_cells(tent, 0.499 * edge) <= 16 * tent.num_cells
+    with pytest.raises(CuttingError, match=r"refined to about .* cells .*try a wider roll"):
+        plan_strips(tent, 1e-4 * size)
+    assert refined_cells(tent, 0.5e-4 * size) > MAX_REFINED_CELLS
+
+
 def longest_edge(mesh) -> float:
     edges = mesh.edges()
     return float(np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1).max())

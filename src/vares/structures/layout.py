@@ -41,7 +41,7 @@ import numpy as np
 from ..geometry.cutting import SNAP, CutMesh, LinesMeetError, cut_mesh
 from ..geometry.line_families import LineFamily, geodesic_between_ends, line_family
 from ..geometry.mesh import SurfaceMesh
-from ..geometry.refine import refine
+from ..geometry.refine import MAX_ROUNDS, refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
 from .panels import Panel, split_panels
 from .widths import pattern_direction, strip_widths
@@ -49,6 +49,7 @@ from .widths import pattern_direction, strip_widths
 __all__ = [
     "APART",
     "CELLS_ACROSS",
+    "MAX_REFINED_CELLS",
     "SEAM_KINDS",
     "StripPlan",
     "pattern_direction",
@@ -61,6 +62,9 @@ SEAM_KINDS = ("geodesic", "planar")
 _EQUALISE, _EQUAL = 6, 1.005
 #: Cells across a strip of roll width at least (by their longest edges; module docs).
 CELLS_ACROSS = 2
+#: The most triangles the surface may be refined to for the strips: a narrower roll is refused
+#: before the refinement (the conic tent at a 1 mm roll filled 24 GB and was killed).
+MAX_REFINED_CELLS = 2_000_000
 #: Neighbouring lines stay at least this fraction of their parameters' difference apart.
 APART = 0.2
 #: Pieces of a plane section shorter than this fraction of the roll width are no cutting lines.
@@ -141,6 +145,13 @@ def plan_strips(
         estimate = sum(strip_widths(whole, family, seam_allowance, edge_allowance)) / width
         if estimate > max_strips:
             raise CuttingError(f"more than {max_strips} strips would be needed")
+    cells = refined_cells(surface, width / CELLS_ACROSS)
+    if cells > MAX_REFINED_CELLS:
+        raise CuttingError(
+            f"strips of {width:g} would need the surface refined to about {cells:,.0f} cells "
+            f"(edges of at most {width / CELLS_ACROSS:g}; at most {MAX_REFINED_CELLS:,}): try a "
+            "wider roll"
+        )
     refined = _Refined(surface, width)
 
     def evaluate(spans: np.ndarray) -> tuple[StripPlan, np.ndarray]:
@@ -188,6 +199,16 @@ def plan_strips(
     plan = tried[best]
     plan.evaluations, plan.history = evaluations, history
     return plan
+
+
+def refined_cells(surface: SurfaceMesh, longest: float) -> float:
+    """About how many triangles the triangle mesh ``surface`` has once refined on its own faces
+    until no edge is longer than ``longest`` (each halving of a cell's longest edge a 1-to-4
+    split, at most :data:`~vares.geometry.refine.MAX_ROUNDS` of them)."""
+    corners = surface.points[surface.cells["triangle"]]
+    edges = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1).max(axis=1)
+    halvings = np.minimum(np.ceil(np.log2(np.maximum(edges / longest, 1.0))), MAX_ROUNDS)
+    return float(np.sum(4.0**halvings))
 
 
 class _Refined:
