@@ -206,12 +206,13 @@ def importtime(command: list[str], repeat: int) -> None:
             sums[package] = sums.get(package, 0.0) + int(own) / 1e6
         totals.append(sums)
     packages = sorted(totals[0], key=lambda k: -totals[0][k])
-    print("| package imported | s |")
-    print("|---|---|")
+    print("| package imported | s (under -X importtime, which slows every import) | share |")
+    print("|---|---|---|")
     everything = statistics.median(sum(t.values()) for t in totals)
     for package in packages[:12]:
-        print(f"| {package} | {statistics.median(t.get(package, 0.0) for t in totals):.3f} |")
-    print(f"| all imports | {everything:.3f} |")
+        own = statistics.median(t.get(package, 0.0) for t in totals)
+        print(f"| {package} | {own:.3f} | {100 * own / everything:.0f} % |")
+    print(f"| all imports | {everything:.3f} | 100 % |")
 
 
 def main() -> None:
