@@ -217,6 +217,14 @@ def test_rhino_files_without_meshes(tmp_path):
         read_3dm(broken)
 
 
+def test_a_file_of_no_mesh_format_is_named_by_its_suffix(tmp_path):
+    mould = tmp_path / "mould.txt"
+    mould.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", encoding="utf-8")
+    with pytest.raises(vares.MeshError, match=r"mould.txt: '\.txt' is no mesh format .*\.obj"):
+        vares.read_mesh(mould)
+    assert vares.read_mesh(mould.rename(tmp_path / "mould.obj")).num_cells == 1
+
+
 def test_report_pictures_are_drawn_at_the_reports_resolution(tmp_path):
     """The report's own pictures are PNGs at its 100 dpi (a 6.5-inch field map is 650 pixels
     wide, a 7-inch view 700) whose cells are opaque colours, not the 150-dpi files'; the pattern

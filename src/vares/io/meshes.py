@@ -206,6 +206,14 @@ def read_raw(path: Path) -> RawSurface:
         return RawSurface(soup.points, soup.cells, soup.polygons)
     if suffix == ".stl":
         check_stl(path)
+    import meshio
+
+    if not any(path.name.lower().endswith(known) for known in meshio.extension_to_filetypes):
+        raise MeshError(
+            f"{path}: {suffix or 'no suffix'!r} is no mesh format vares reads (.obj, .off, .stl, "
+            ".ply, .vtu, .msh, .3dm, .dxf and the others of meshio): give the file its format's "
+            "suffix"
+        )
     return _read_meshio(path)
 
 
