@@ -10,7 +10,7 @@ from ..materials import InadmissibleState
 from .failure import Failure
 from .linear import SingularMatrixError
 
-__all__ = ["MAX_TURN_SCALE", "LineSearch", "StepPath"]
+__all__ = ["MAX_TURN_SCALE", "LineSearch", "StepPath", "backtrack"]
 
 
 #: The largest multiple of a projected step's turn that :meth:`_LineSearch._turn_further` tries.
@@ -55,6 +55,32 @@ class StepPath:
         angle = (alpha if turned is None else turned) * self.turn
         c, s = np.cos(angle), np.sin(angle)
         return self.centre + (self.arm + alpha * self.rest) @ np.array([[c, s], [-s, c]])
+
+
+def backtrack(problem, path, alpha: float, energy: float, slope: float, noise: float):
+    """Armijo backtracking along ``path`` (a :class:`StepPath`) from the step length
+    ``alpha``, halved up to 40 times, until the energy falls below ``energy + 1e-4 α slope``
+    (within ``noise``): ``(point, α, its evaluation or None, its energy)``, or ``None``. The
+    first trial, usually accepted near the solution, is evaluated with its derivatives (the
+    next iteration needs them); one that folds a cell or cannot be evaluated counts as
+    infinite energy, so shorter steps are tried."""
+    for tries in range(40):
+        trial = path.at(alpha)
+        at_trial = None
+        if tries > 0:
+            value = problem.energy(trial)
+        elif problem.inverted_cells(trial).size:
+            value = np.inf
+        else:
+            try:
+                at_trial = problem.evaluate(trial, order=2)
+                value = at_trial.energy
+            except InadmissibleState:  # like a fold: shorter steps are tried
+                value = np.inf
+        if value <= energy + 1e-4 * alpha * slope + noise:
+            return trial, alpha, at_trial, value
+        alpha *= 0.5
+    return None
 
 
 class LineSearch:
@@ -106,27 +132,15 @@ class LineSearch:
             self.bounded_by = (
                 problem.inverted_cells(path.at(min(1.0, 1.01 * bound))) if bound < 1 else None
             )
-            for backtrack in range(40):
-                trial = path.at(alpha)
-                at_trial = None
-                if backtrack > 0:
-                    energy = problem.energy(trial)
-                elif problem.inverted_cells(trial).size:
-                    energy = np.inf
-                else:
-                    try:
-                        at_trial = problem.evaluate(trial, order=2)
-                        energy = at_trial.energy
-                    except InadmissibleState:  # like a fold: shorter steps are tried
-                        energy = np.inf
-                if energy <= self.energy + 1e-4 * alpha * slope + ctx.energy_noise:
-                    tangent = "projected" if self.projected else "exact"
-                    if self.projected and alpha == 1.0 and path.turn != 0.0:
-                        turned = self._turn_further(path, energy)
-                        if turned is not None:
-                            return turned, alpha, "projected, turned", None
-                    return trial, alpha, tangent, at_trial
-                alpha *= 0.5
+            found = backtrack(problem, path, alpha, self.energy, slope, ctx.energy_noise)
+            if found is not None:
+                trial, alpha, at_trial, energy = found
+                tangent = "projected" if self.projected else "exact"
+                if self.projected and alpha == 1.0 and path.turn != 0.0:
+                    turned = self._turn_further(path, energy)
+                    if turned is not None:
+                        return turned, alpha, "projected, turned", None
+                return trial, alpha, tangent, at_trial
         raise Failure("the line search found no decrease of the energy", x)
 
     def _turn_further(self, path: StepPath, energy: float) -> np.ndarray | None:

@@ -33,9 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..materials import InadmissibleState
 from .failure import Failure
-from .line_search import StepPath
+from .line_search import StepPath, backtrack
 from .linear import SingularMatrixError
 
 __all__ = [
@@ -147,23 +146,8 @@ class TurningSearch:
         self.bounded_by = (
             problem.inverted_cells(path.at(min(1.0, 1.01 * bound))) if bound < 1 else None
         )
-        for backtrack in range(40):
-            trial = path.at(alpha)
-            at_trial = None
-            if backtrack > 0:
-                energy = problem.energy(trial)
-            elif problem.inverted_cells(trial).size:
-                energy = np.inf
-            else:
-                try:
-                    at_trial = problem.evaluate(trial, order=2)
-                    energy = at_trial.energy
-                except InadmissibleState:  # like a fold: shorter steps are tried
-                    energy = np.inf
-            if energy <= self.energy + 1e-4 * alpha * slope + ctx.energy_noise:
-                return trial, alpha, at_trial
-            alpha *= 0.5
-        return None
+        found = backtrack(problem, path, alpha, self.energy, slope, ctx.energy_noise)
+        return None if found is None else found[:3]
 
 
 class TurningSystem:
