@@ -197,19 +197,10 @@ def turned(rings: int, law: str, locking: float, angles: list[float], length: fl
             heading = np.cos(a) * np.array([0.0, 0.0, 1.0]) + np.sin(a) * along
             s = np.linspace(0.0, length / 100.0, 12)[:, None]
             lines.append(100.0 * (np.cos(s) * mouth + np.sin(s) * heading))
-        clock = time.perf_counter()
-        darted = solve_with_darts(
-            mesh, LAWS[law](), locking_angle=locking, polylines=lines, warp_direction=warp
-        )
-        s = darted.summary()
-        r = s["rounds"][0]
-        openings = ", ".join(f"{v:.4g}" for v in s["mouth_openings"])
-        lengths = ", ".join(f"{v:.4g}" for v in s["dart_lengths"])
+        _, text = given(mesh, law, locking, lines, warp)
         print(
             f"hemisphere {rings} ({mesh.num_cells} cells), {law}, darts turned {angle:g}° from "
-            f"the meridian: before {s['max_shear_before']:.2f}°, after {r['max_shear']:.2f}° "
-            f"({r['iterations']} it, converged {r['converged']}); lengths {lengths}; mouths "
-            f"{openings}; {time.perf_counter() - clock:.1f} s"
+            f"the meridian: {text}"
         )
 
 
@@ -223,21 +214,32 @@ def radial(cell_size: float, law: str, locking: float, end: float, angle: float)
             xy = np.array([55.0 * sx, 0.0]) + np.linspace(end, 120.0, 200)[:, None] * ray
             xy = xy[(xy[:, 0] / 155.0) ** 2 + (xy[:, 1] / 100.0) ** 2 < 0.999]
             lines.append(np.column_stack([xy, double_dome_height(xy[:, 0], xy[:, 1])])[::-1])
+    darted, text = given(mesh, law, locking, lines, warp)
+    print(
+        f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, darts along rays at "
+        f"{angle:g}° to {end:g} mm of the domes' centres: {text}"
+    )
+    quadrants(darted)
+
+
+def given(mesh, law: str, locking: float, lines: list[np.ndarray], warp):
+    """The pattern with the given dart ``lines`` open, and the line printed of it: the largest
+    shear before and after, the solve's iterations, the darts' lengths and mouth openings."""
     clock = time.perf_counter()
     darted = solve_with_darts(
         mesh, LAWS[law](), locking_angle=locking, polylines=lines, warp_direction=warp
     )
     s = darted.summary()
+    if not s["rounds"]:
+        return darted, f"before {s['max_shear_before']:.2f}°, no solve with the darts"
     r = s["rounds"][0]
     openings = ", ".join(f"{v:.4g}" for v in s["mouth_openings"])
     lengths = ", ".join(f"{v:.4g}" for v in s["dart_lengths"])
-    print(
-        f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, darts along rays at "
-        f"{angle:g}° to {end:g} mm of the domes' centres: before {s['max_shear_before']:.2f}°, "
-        f"after {r['max_shear']:.2f}° ({r['iterations']} it, converged {r['converged']}); "
-        f"lengths {lengths}; mouths {openings}; {time.perf_counter() - clock:.1f} s"
+    return darted, (
+        f"before {s['max_shear_before']:.2f}°, after {r['max_shear']:.2f}° "
+        f"({r['iterations']} it, converged {r['converged']}); lengths {lengths}; mouths "
+        f"{openings}; {time.perf_counter() - clock:.1f} s"
     )
-    quadrants(darted)
 
 
 def quadrants(darted) -> None:
