@@ -25,11 +25,61 @@ from ..materials.fitting import FabricFit
 from .fabric_band import FabricBand
 from .html_parts import figure, number, page, report_drawing, table
 
-__all__ = ["band_report", "band_section", "fit_report"]
+__all__ = ["band_report", "band_section", "compensation_rows", "constant_rows", "fit_report"]
 
 
 def _record(records: list[BiaxialRecord], name: str, source: str) -> BiaxialRecord | None:
     return next((r for r in records if (r.name, r.source) == (name, source)), None)
+
+
+def constant_rows(fitted: FabricFit) -> list[tuple[str, ...]]:
+    """The constants table: per specimen its name, E1, E2, nu12, nu21 (± standard error of the
+    fit) and rms residual; last the mean ± std over the specimens (no residual)."""
+    rows = [
+        (
+            f.name,
+            f"{f.E_w:.1f} ± {f.standard_errors['E_w']:.1f}",
+            f"{f.E_f:.1f} ± {f.standard_errors['E_f']:.1f}",
+            f"{f.nu_wf:.3f} ± {f.standard_errors['nu_wf']:.3f}",
+            f"{f.nu_fw:.3f} ± {f.standard_errors['nu_fw']:.3f}",
+            f"{f.rms:.2e}",
+        )
+        for f in fitted.fits
+    ]
+    m, s = fitted.constants.mean, fitted.constants.std
+    rows.append(
+        (
+            "mean ± std",
+            f"{m['E_w']:.1f} ± {s['E_w']:.1f}",
+            f"{m['E_f']:.1f} ± {s['E_f']:.1f}",
+            f"{m['nu_wf']:.3f} ± {s['nu_wf']:.3f}",
+            f"{m['nu_fw']:.3f} ± {s['nu_fw']:.3f}",
+            "",
+        )
+    )
+    return rows
+
+
+def compensation_rows(fitted: FabricFit) -> list[tuple[str, str, str]]:
+    """The compensation table (warp, fill in %): per specimen, the mean ± std and, when a law was
+    fitted, its value; empty without compensation records."""
+    if fitted.compensation is None:
+        return []
+    rows = [
+        (c.name, f"{100 * c.warp:.3f} %", f"{100 * c.fill:.3f} %") for c in fitted.compensations
+    ]
+    cm, cs = fitted.compensation.mean, fitted.compensation.std
+    rows.append(
+        (
+            "mean ± std",
+            f"{100 * cm['warp']:.3f} ± {100 * cs['warp']:.3f} %",
+            f"{100 * cm['fill']:.3f} ± {100 * cs['fill']:.3f} %",
+        )
+    )
+    law = fitted.law_compensation()
+    if law is not None:
+        rows.append(("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %"))
+    return rows
 
 
 def fit_report(fitted: FabricFit, records: list[BiaxialRecord]) -> str:
@@ -49,32 +99,10 @@ def fit_report(fitted: FabricFit, records: list[BiaxialRecord]) -> str:
             "than two thirds of its residual): the constants are secant values over the range"
         )
     parts = page(fitted.name, f"Fabric fit: {fitted.name}", "fitted", single)
-    m, s = fitted.constants.mean, fitted.constants.std
-    rows = [
-        (
-            f.name,
-            f"{f.E_w:.1f} ± {f.standard_errors['E_w']:.1f}",
-            f"{f.E_f:.1f} ± {f.standard_errors['E_f']:.1f}",
-            f"{f.nu_wf:.3f} ± {f.standard_errors['nu_wf']:.3f}",
-            f"{f.nu_fw:.3f} ± {f.standard_errors['nu_fw']:.3f}",
-            f"{f.rms:.2e}",
-        )
-        for f in fitted.fits
-    ]
-    rows.append(
-        (
-            "mean ± std",
-            f"{m['E_w']:.1f} ± {s['E_w']:.1f}",
-            f"{m['E_f']:.1f} ± {s['E_f']:.1f}",
-            f"{m['nu_wf']:.3f} ± {s['nu_wf']:.3f}",
-            f"{m['nu_fw']:.3f} ± {s['nu_fw']:.3f}",
-            "",
-        )
-    )
     parts.append("<h2>Elastic constants (MSAJ/M-02)</h2>")
     parts.append(
         table(
-            rows,
+            constant_rows(fitted),
             ["specimen", "E1 (kN/m)", "E2 (kN/m)", "nu12", "nu21", "rms residual"],
             "constants",
         )
@@ -107,22 +135,9 @@ def fit_report(fitted: FabricFit, records: list[BiaxialRecord]) -> str:
         if fitted.compensation is not None and fitted.prestress is not None:
             p = fitted.prestress
             parts.append(f"<h2>Compensation values (EN 17117-2) at {p[0]:g}/{p[1]:g} kN/m</h2>")
-            values = [
-                (c.name, f"{100 * c.warp:.3f} %", f"{100 * c.fill:.3f} %")
-                for c in fitted.compensations
-            ]
-            cm, cs = fitted.compensation.mean, fitted.compensation.std
-            values.append(
-                (
-                    "mean ± std",
-                    f"{100 * cm['warp']:.3f} ± {100 * cs['warp']:.3f} %",
-                    f"{100 * cm['fill']:.3f} ± {100 * cs['fill']:.3f} %",
-                )
+            parts.append(
+                table(compensation_rows(fitted), ["specimen", "warp", "fill"], "compensation")
             )
-            law = fitted.law_compensation()
-            if law is not None:
-                values.append(("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %"))
-            parts.append(table(values, ["specimen", "warp", "fill"], "compensation"))
             pairs = [
                 (record, c)
                 for c in fitted.compensations

@@ -169,6 +169,8 @@ def _show(fitted: "FabricFit") -> None:
     """The fit's tables: constants per specimen, residual per load ratio, compensation."""
     from rich.table import Table
 
+    from ..fabric_report import compensation_rows, constant_rows
+
     table = Table(
         "specimen",
         "E1 (warp)",
@@ -179,27 +181,11 @@ def _show(fitted: "FabricFit") -> None:
         "nonlinear rms",
         title="fitted constants (kN/m; ± standard error of the fit)",
     )
-    for f in fitted.fits:
-        e = f.standard_errors
-        table.add_row(
-            f.name,
-            f"{f.E_w:.1f} ± {e['E_w']:.1f}",
-            f"{f.E_f:.1f} ± {e['E_f']:.1f}",
-            f"{f.nu_wf:.3f} ± {e['nu_wf']:.3f}",
-            f"{f.nu_fw:.3f} ± {e['nu_fw']:.3f}",
-            f"{f.rms:.2e}",
-            f"{f.nonlinear.get('rms', float('nan')):.2e}" + (" *" if f.linear_is_poor else ""),
-        )
-    m, s = fitted.constants.mean, fitted.constants.std
-    table.add_row(
-        "mean ± std",
-        f"{m['E_w']:.1f} ± {s['E_w']:.1f}",
-        f"{m['E_f']:.1f} ± {s['E_f']:.1f}",
-        f"{m['nu_wf']:.3f} ± {s['nu_wf']:.3f}",
-        f"{m['nu_fw']:.3f} ± {s['nu_fw']:.3f}",
-        "",
-        "",
-    )
+    *rows, mean = constant_rows(fitted)
+    for f, row in zip(fitted.fits, rows, strict=True):
+        nonlinear = f"{f.nonlinear.get('rms', float('nan')):.2e}"
+        table.add_row(*row, nonlinear + (" *" if f.linear_is_poor else ""))
+    table.add_row(*mean, "")
     console.print(table)
     if any(f.linear_is_poor for f in fitted.fits):
         console.print(
@@ -221,17 +207,8 @@ def _show(fitted: "FabricFit") -> None:
             "fill",
             title=f"compensation values at {fitted.prestress[0]:g}/{fitted.prestress[1]:g} kN/m",
         )
-        for c in fitted.compensations:
-            values.add_row(c.name, f"{100 * c.warp:.3f} %", f"{100 * c.fill:.3f} %")
-        cm, cs = fitted.compensation.mean, fitted.compensation.std
-        values.add_row(
-            "mean ± std",
-            f"{100 * cm['warp']:.3f} ± {100 * cs['warp']:.3f} %",
-            f"{100 * cm['fill']:.3f} ± {100 * cs['fill']:.3f} %",
-        )
-        law = fitted.law_compensation()
-        if law is not None:
-            values.add_row("fitted law", f"{100 * law[0]:.3f} %", f"{100 * law[1]:.3f} %")
+        for row in compensation_rows(fitted):
+            values.add_row(*row)
         console.print(values)
     single = [
         what
