@@ -175,6 +175,7 @@ def test_darts_bring_the_hemisphere_below_the_locking_angle(hemisphere_darts):
     assert darted.before.converged and darted.after.converged
     assert darted.max_shear_before > LOCKING + 5.0
     assert darted.relieved and darted.max_shear_after < LOCKING
+    assert darted.final is darted.after
     assert darted.max_shear_before - darted.max_shear_after > 5.0
     assert len(darted.dart_lines) == 4
     for gaps in darted.slits.lip_gaps(darted.after.material_coordinates):
@@ -309,6 +310,7 @@ def test_no_dart_where_none_is_needed():
     darted = solve_with_darts(cap, law, locking_angle=LOCKING, darts="auto")
     assert darted.before.converged and darted.max_shear_before < LOCKING
     assert darted.after is None and darted.rounds == [] and darted.relieved
+    assert darted.final is darted.before
     assert darted.summary()["darts"] == 0
     with pytest.raises(ValueError, match="dart_lines names a file"):
         solve_with_darts(cap, law, locking_angle=LOCKING, dart_lines="darts.txt")

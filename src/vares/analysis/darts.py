@@ -275,11 +275,15 @@ class DartedPattern:
         return None if self.after is None else self.rounds[self.chosen].max_shear
 
     @property
+    def final(self) -> PatternResult:
+        """The pattern with the darts open, or without darts when none was opened."""
+        return self.before if self.after is None else self.after
+
+    @property
     def relieved(self) -> bool:
         """Whether the largest shear ends below the locking angle (with or without darts)."""
-        final = self.after if self.after is not None else self.before
-        shear = self.max_shear_after if self.after is not None else self.max_shear_before
-        return bool(final.converged and shear < self.locking_angle)
+        shear = self.max_shear_before if self.after is None else self.max_shear_after
+        return bool(self.final.converged and shear < self.locking_angle)
 
     def dart_pattern_lines(self) -> list[np.ndarray]:
         """Both lips of every dart in the final pattern ``(k, 2)`` each: mouth → tip → mouth."""

@@ -136,13 +136,7 @@ def drape_page(ply: PlyDrape, darted: DartedPattern | None, name: str, units: st
     warnings = []
     if darted is not None and not darted.relieved:
         warnings.append("the largest shear is not below the locking angle")
-    status = (
-        "drape"
-        if darted is None
-        else status_text(
-            (darted.after or darted.before).converged, (darted.after or darted.before).reason
-        )
-    )
+    status = "drape" if darted is None else status_text(darted.final.converged, darted.final.reason)
     parts = page(name, f"Drape: {name}", status, warnings)
     parts += ["<h2>Kinematic drape and producibility</h2>", table(_ply_rows(ply, units))]
     if darted is not None:

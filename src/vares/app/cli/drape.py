@@ -141,7 +141,7 @@ def drape(
                 _show_darts(darted)
             for path in paths:
                 console.print(f"  wrote {path}")
-        if darted is not None and not (darted.after or darted.before).converged:
+        if darted is not None and not darted.final.converged:
             raise typer.Exit(1)
 
     guarded(body)
@@ -171,7 +171,7 @@ def _write_darts(folder, paths: list[Path], darted, units: str, name: str) -> No
     from ...io.dxf import CutPiece, write_dxf
     from ...io.meshes import write_surface
 
-    final = darted.after or darted.before
+    final = darted.final
     fields = {"shear_angle": final.fields["shear_angle"]}
     flat = final.material_coordinates
     point_data = {"flat_u": flat[:, 0], "flat_v": flat[:, 1]}
