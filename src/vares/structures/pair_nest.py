@@ -18,6 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .nesting import NestedPiece, RollNest, check_nest, clearance_of
+from .widths import profiles
 
 __all__ = ["pair_nest"]
 
@@ -31,22 +32,6 @@ _GRID = 1e-9
 
 def _placed(points: np.ndarray, rotation: float, translation) -> np.ndarray:
     return NestedPiece(0, rotation, np.asarray(translation, dtype=float)).place(points)
-
-
-def _profile(points: np.ndarray, stations: np.ndarray, upper: bool) -> np.ndarray:
-    """The highest (``upper``) or lowest point of a ring across each station along x (−inf or
-    +inf where the ring does not reach)."""
-    a, b = points, np.roll(points, -1, axis=0)
-    low, high = np.minimum(a[:, 0], b[:, 0]), np.maximum(a[:, 0], b[:, 0])
-    inside = (low[None, :] <= stations[:, None]) & (stations[:, None] <= high[None, :])
-    span = np.where(b[:, 0] != a[:, 0], b[:, 0] - a[:, 0], 1.0)
-    t = np.clip((stations[:, None] - a[None, :, 0]) / span[None, :], 0.0, 1.0)
-    y = a[None, :, 1] + t * (b[:, 1] - a[:, 1])[None, :]
-    ends = np.maximum(a[:, 1], b[:, 1]) if upper else np.minimum(a[:, 1], b[:, 1])
-    y = np.where((b[:, 0] == a[:, 0])[None, :], ends[None, :], y)
-    if upper:
-        return np.where(inside, y, -np.inf).max(axis=1)
-    return np.where(inside, y, np.inf).min(axis=1)
 
 
 def _column(first: np.ndarray, second: np.ndarray, separation: float, edge: float):
@@ -63,7 +48,7 @@ def _column(first: np.ndarray, second: np.ndarray, separation: float, edge: floa
             top = top - top.min(axis=0)
             reach = min(np.ptp(bottom[:, 0]), np.ptp(top[:, 0]))
             stations = np.linspace(0.0, reach, _STATIONS)
-            gap = np.max(_profile(bottom, stations, True) - _profile(top, stations, False))
+            gap = np.max(profiles(bottom, stations)[0] - profiles(top, stations)[1])
             below = Polygon(bottom).buffer(separation)
 
             def overlaps(lift: float, top=top, below=below) -> bool:

@@ -33,6 +33,7 @@ __all__ = [
     "envelopes",
     "pair_width",
     "pattern_direction",
+    "profiles",
     "roll_estimate",
     "strip_widths",
 ]
@@ -50,19 +51,28 @@ def envelopes(
     warp = np.array([1.0, 0.0]) if warp is None else np.asarray(warp, dtype=float)
     warp = warp / np.linalg.norm(warp)
     ring = np.asarray(outline, dtype=float)
-    along, across = ring @ warp, ring @ np.array([-warp[1], warp[0]])
+    along = ring @ warp
     s = np.linspace(along.min(), along.max(), samples)
-    a0, a1 = along, np.roll(along, -1)
-    c0, c1 = across, np.roll(across, -1)
+    across = ring @ np.array([-warp[1], warp[0]])
+    upper, lower = profiles(np.column_stack([along, across]), s)
+    return s, upper, lower
+
+
+def profiles(ring: np.ndarray, stations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The highest and lowest point (second coordinate) of a ring ``(k, 2)`` across each of
+    the ``stations`` along its first coordinate: ``upper`` and ``lower``, −inf and +inf where
+    the ring does not reach."""
+    a0, c0 = ring[:, 0], ring[:, 1]
+    a1, c1 = np.roll(a0, -1), np.roll(c0, -1)
     low, high = np.minimum(a0, a1), np.maximum(a0, a1)
     # every edge's crossing with every station (vertical edges give both of their ends)
-    inside = (low[None, :] <= s[:, None]) & (s[:, None] <= high[None, :])
-    t = np.clip((s[:, None] - a0[None, :]) / np.where(a1 != a0, a1 - a0, 1.0)[None, :], 0, 1)
+    inside = (low[None, :] <= stations[:, None]) & (stations[:, None] <= high[None, :])
+    t = np.clip((stations[:, None] - a0[None, :]) / np.where(a1 != a0, a1 - a0, 1.0)[None, :], 0, 1)
     y = c0[None, :] + t * (c1 - c0)[None, :]
     flat = (a1 == a0)[None, :] & inside
     upper = np.where(inside, np.where(flat, np.maximum(c0, c1)[None, :], y), -np.inf).max(axis=1)
     lower = np.where(inside, np.where(flat, np.minimum(c0, c1)[None, :], y), np.inf).min(axis=1)
-    return s, upper, lower
+    return upper, lower
 
 
 def pair_width(
