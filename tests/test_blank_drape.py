@@ -94,6 +94,31 @@ def test_flange_continues_the_faces_at_the_edge():
 
 
 # ---------------------------------------------------------------------------------- analytic
+def test_sliding_basis_has_two_tangents_per_free_node_one_per_guided_none_held():
+    from vares.mechanics.contact import SlidingNodes
+
+    surface = mould_surface(irregular_cap(100.0, 60.0, 8, 0.3, 1), 5.0)
+    points = surface.mesh.points[:40] + 0.1
+    held = np.zeros(40, dtype=bool)
+    held[[3, 7]] = True
+    plane = np.array([0.6, 0.8, 0.0])
+    guided = {5: (plane, 0.0), 7: (plane, 0.0), 11: (np.array([0.0, 1.0, 0.0]), 0.0)}
+    nodes = SlidingNodes.placed(surface, points, held, guided)
+    T = nodes.basis().toarray()
+    assert T.shape == (120, 2 * 36 + 2)
+    assert np.allclose(T.T @ T, np.eye(T.shape[1]))  # orthonormal columns
+    per_node = np.abs(T).reshape(40, 3, -1).sum(axis=1) > 0  # (nodes, columns)
+    assert (per_node.sum(axis=0) == 1).all()  # every column moves one node
+    counts = per_node.sum(axis=1)
+    assert counts[[3, 7]].tolist() == [0, 0] and counts[[5, 11]].tolist() == [1, 1]
+    assert (np.delete(counts, [3, 5, 7, 11]) == 2).all()
+    normals = surface.normals[nodes.faces]
+    moves = T.reshape(40, 3, -1)
+    assert np.allclose(np.einsum("ni,nic->nc", normals, moves), 0.0)  # tangential
+    assert np.allclose(plane @ moves[5], 0.0)  # the guided node stays in its plane
+    assert np.flatnonzero(per_node[:, :2].any(axis=1)).tolist() == [0]  # columns in node order
+
+
 def test_flat_mould_leaves_the_blank_unchanged():
     angle = np.radians(16.7)
     warp = np.array([np.cos(angle), np.sin(angle), 0.0])

@@ -296,10 +296,10 @@ def _settle(
             step, exact = _direction(problem, evaluation, assembler, basis, residual, solver, exact)
         except SingularMatrixError as exc:
             return nodes, history, f"singular tangent ({exc})", False
-        moved = _line_search(problem, assembler, nodes, step, residual, exact, noise)
+        moved = _line_search(problem, assembler, nodes, basis, step, residual, exact, noise)
         if moved is None and exact:  # the positive semi-definite step may still get on
             step, exact = _direction(problem, evaluation, assembler, basis, residual, solver, False)
-            moved = _line_search(problem, assembler, nodes, step, residual, exact, noise)
+            moved = _line_search(problem, assembler, nodes, basis, step, residual, exact, noise)
         if moved is None:
             if unbalanced <= facets:
                 return nodes, history, None, True
@@ -342,12 +342,14 @@ def _direction(problem, evaluation, assembler, basis, residual, solver, exact: b
     return (basis @ solver.solve(-residual)).reshape(-1, 3), False
 
 
-def _line_search(problem, assembler, nodes: SlidingNodes, step, residual, exact: bool, noise):
+def _line_search(
+    problem, assembler, nodes: SlidingNodes, basis, step, residual, exact: bool, noise
+):
     """Halve the step until no cell turns over and the energy decreases enough (Armijo; a
     step of the positive semi-definite tangent) or the residual does (a step of the exact
-    tangent, module docs): ``(nodes, step length)`` or None."""
+    tangent, module docs): ``(nodes, step length)`` or None. ``basis``: ``nodes.basis()``."""
     energy = _energy(problem, nodes)
-    slope = residual @ (nodes.basis().T @ step.ravel())
+    slope = residual @ (basis.T @ step.ravel())
     norm = float(np.linalg.norm(residual))
     alpha = 1.0
     for _ in range(HALVINGS):

@@ -59,24 +59,19 @@ class SlidingNodes:
         """``T`` ``(3 n, k)``: the free tangent directions (two per sliding node, one per guided
         node, none for held ones), one column each."""
         n = len(self.positions)
-        bases = self.mould.tangent_bases(self.faces)  # (n, 3, 2)
-        normals = self.mould.normals[self.faces]
-        rows, cols, values = [], [], []
-        column = 0
-        for a in range(n):
-            if self.held[a]:
-                continue
-            if a in self.guided:
-                direction = np.cross(normals[a], self.guided[a][0])
-                vectors = [direction / np.linalg.norm(direction)]
-            else:
-                vectors = [bases[a, :, 0], bases[a, :, 1]]
-            for v in vectors:
-                rows.extend(3 * a + np.arange(3))
-                cols.extend([column] * 3)
-                values.extend(v)
-                column += 1
-        return sp.csr_matrix((values, (rows, cols)), shape=(3 * n, column))
+        vectors = self.mould.tangent_bases(self.faces).transpose(0, 2, 1).copy()  # (n, 2, 3)
+        counts = np.where(self.held, 0, 2)
+        if self.guided:
+            nodes = np.fromiter(self.guided, dtype=np.int64, count=len(self.guided))
+            planes = np.array([self.guided[a][0] for a in nodes.tolist()], dtype=float)
+            direction = np.cross(self.mould.normals[self.faces[nodes]], planes)
+            vectors[nodes, 0] = direction / np.linalg.norm(direction, axis=1)[:, None]
+            counts[nodes] = np.where(self.held[nodes], 0, 1)
+        used = np.arange(2)[None, :] < counts[:, None]  # (n, 2): the node's columns
+        node, _ = np.nonzero(used)
+        rows = (3 * node[:, None] + np.arange(3)).ravel()
+        cols = np.repeat(np.arange(len(node)), 3)
+        return sp.csr_matrix((vectors[used].ravel(), (rows, cols)), shape=(3 * n, len(node)))
 
     def moved(self, step: np.ndarray) -> SlidingNodes:
         """The nodes moved by ``step`` ``(n, 3)`` (tangential) and put back onto the mould; held
