@@ -5,32 +5,32 @@ The one runner behind ``vares pattern``, ``example``, ``run``, ``panels``, ``cut
 ``erect``: every command builds a :class:`vares.app.job.Job` and hands it here, so they all get
 the same outputs (see :mod:`vares.app.outputs`). Everything that can be checked is checked before
 the solve; the files of a run are staged and put in place as one set (:mod:`vares.app.staging`).
-:func:`run_erection` erects the patterns an earlier run wrote (``vares erect DIR``).
+:func:`run_erection` (:mod:`vares.app.erection_run`) erects the patterns an earlier run wrote
+(``vares erect DIR``).
 """
 
 from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..analysis.checks import pattern_warnings
 from ..analysis.compensation import compensation_report
-from ..analysis.erection import ErectionResult, erect
+from ..analysis.erection import erect
 from ..analysis.erection_model import Pattern
-from ..analysis.options import ErectionOptions
 from ..geometry.examples import EXAMPLE_PLANES
 from ..geometry.mesh import SurfaceMesh
 from ..io.files import check_writable, write_text
 from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
 from ..structures.matching import solve_structure
-from .erection_outputs import erection_files, write_erection
-from .inputs import Input, load_input, saved_patterns, saved_units
-from .job import Job, JobError, load_job
+from .erection_outputs import write_erection
+from .erection_run import ErectionRun, run_erection
+from .inputs import Input, load_input
+from .job import Job, JobError
 from .outcome import JobOutcome, PanelOutcome
 from .outputs import (
     JOB_FILE,
@@ -43,7 +43,7 @@ from .outputs import (
     write_structure,
 )
 from .run_band import check_run_band, run_band
-from .staging import OutputFolder, add_to_manifest, listed
+from .staging import OutputFolder, listed
 
 __all__ = ["ErectionRun", "run_erection", "run_job"]
 
@@ -275,79 +275,6 @@ def _seam_reports_after(structure):
             )
         )
     return out
-
-
-@dataclass
-class ErectionRun:
-    """What ``vares erect DIR`` did: the job it read, the erection and the files written."""
-
-    job: Job
-    result: ErectionResult
-    files: list[Path] = field(default_factory=list)
-    units: str = "m"
-
-
-def run_erection(
-    directory: str | Path,
-    options: ErectionOptions | None = None,
-    *,
-    force: bool = False,
-    report: bool = False,
-    callback: Callable[[IterationRecord], None] | None = None,
-) -> ErectionRun:
-    """Erect the patterns that a run wrote into ``directory`` (from its ``job.toml``, the panels'
-    ``surface.vtu``, ``pattern.vtu`` and ``summary.json``) and write ``directory/erect/`` (as one
-    set, added to the run's manifest).
-
-    ``options`` default to the job's ``[erection]`` table (or the defaults); the tolerance,
-    iteration limit and linear solver are the job's.
-    """
-    directory = Path(directory)
-    job_file = directory / JOB_FILE
-    if not job_file.is_file():
-        raise FileNotFoundError(
-            f"no {JOB_FILE} in {directory}: erect an output directory written by "
-            "'vares pattern', 'example', 'run' or 'panels'"
-        )
-    job = load_job(job_file).with_output(directory)
-    options = options or job.erection or ErectionOptions()
-    material = job.material.build(job.base)
-    patterns = saved_patterns(job)
-    target = directory / "erect"
-    folder = OutputFolder(
-        target,
-        erection_files(target, report),
-        force=force,
-        inputs=[],
-        manifest=False,
-        known=[p for p in listed(directory) if target.resolve() in p.resolve().parents],
-    )
-    folder.check()
-    result = erect(
-        patterns,
-        material,
-        job.material.thickness,
-        solver=job.solve,
-        options=options,
-        callback=callback,
-    )
-    units = saved_units(job)
-    root = folder.start()
-    try:
-        staged = write_erection(result, root, units)
-        if report:
-            from .erection_report import write_erection_report
-
-            staged.append(write_erection_report(result, root, units))
-        files = [folder.directory / Path(p).relative_to(root) for p in staged]
-        # listed beside the old ones first: killed before the commit, the run's folder still
-        # knows every file of erect/ as its own; trimmed to the new ones once they are in place
-        add_to_manifest(directory, files, replacing=None)
-        folder.commit()
-        add_to_manifest(directory, files, replacing=folder.directory)
-    finally:
-        folder.discard()
-    return ErectionRun(job, result, files, units)
 
 
 def _panel(
