@@ -165,6 +165,22 @@ def test_pair_matrix_shows_the_seeds_dilemma(laminate):
     assert deviation[i0, i90] < 0.05
 
 
+def test_plies_that_drape_alike_share_one_drape():
+    """A symmetric stack's halves are draped once, also when a ply spells out the laminate's
+    fabric kind or the locking angle it would take anyway."""
+    alike = [
+        PlyOptions(name="P1", orientation=0.0),
+        PlyOptions(name="P2", orientation=45.0),
+        PlyOptions(name="P3", orientation=45.0, fabric_kind="ncf-biaxial"),
+        PlyOptions(name="P4", orientation=360.0, locking_angle=50.0),
+        PlyOptions(name="P5", orientation=0.0, fabric_kind="woven-plain"),
+    ]
+    plies = [Ply(o, NCF) for o in alike]
+    result = drape_laminate(mould(), plies, workers=1, kinematic=False)
+    assert result.ply_drape == {"P1": "0°", "P2": "45°", "P3": "45°", "P4": "0°", "P5": "0° (2)"}
+    assert result.drape("P5").locking_angle == 40.0
+
+
 def test_a_region_ply_covers_its_cells_only():
     mesh = mould()
     centroids = mesh.points[mesh.cells["triangle"]].mean(axis=1)

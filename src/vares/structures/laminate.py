@@ -332,7 +332,7 @@ def drape_laminate(
         sub, nodes = submesh(mesh, cells)
         seed_on_mould(sub, o.seed, f"ply {o.name!r}")
         darts = dart_task(ply, options, sub)
-        key = drape_key(ply, seed, cells, darts)
+        key = drape_key(ply, options, seed, cells, darts)
         ply_drape[o.name] = key
         if key in groups:
             groups[key]["plies"].append(o.name)

@@ -165,9 +165,12 @@ def dart_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str
     }
 
 
-def drape_key(ply: Ply, seed: np.ndarray, cells: np.ndarray, darts: dict | None) -> tuple:
+def drape_key(
+    ply: Ply, options: LaminateOptions, seed: np.ndarray, cells: np.ndarray, darts: dict | None
+) -> tuple:
     """What makes two plies one drape: orientation, material, seed, fabric kind, locking
-    angle, cells and darts (the plies of a symmetric stack's halves share it)."""
+    angle (both as the ply takes them, its own or the laminate's), cells and darts (the plies
+    of a symmetric stack's halves share it)."""
     o = ply.options
     if darts is not None and darts["polylines"] is not None:
         digest = hashlib.sha1(
@@ -179,7 +182,7 @@ def drape_key(ply: Ply, seed: np.ndarray, cells: np.ndarray, darts: dict | None)
         round(float(o.orientation) % 360.0, 9),
         repr(ply.material.parameters) + type(ply.material).__name__,
         tuple(np.round(seed, 12)),
-        o.fabric_kind,
-        o.locking_angle,
+        o.fabric_kind or options.fabric_kind,
+        ply_locking_angle(options, o),
         cells.tobytes(),
     )
