@@ -24,7 +24,7 @@ import numpy as np
 
 from .mesh import SurfaceMesh
 from .surface_lines import triangulated
-from .surface_points import FaceLocator
+from .surface_points import FaceLocator, face_neighbours
 
 __all__ = ["Mould", "mould_surface"]
 
@@ -132,12 +132,19 @@ def _inside_outwardness(points, boundary, edges) -> np.ndarray:
     return out
 
 
-def _conormals(points, triangles, loop) -> np.ndarray:
+def _boundary_faces(triangles: np.ndarray) -> dict[tuple[int, int], int]:
+    """The face of every boundary side, keyed by the side's nodes in cell orientation."""
+    face, corner = np.nonzero(face_neighbours(triangles) < 0)
+    a = triangles[face, (corner + 1) % 3].tolist()
+    b = triangles[face, (corner + 2) % 3].tolist()
+    return dict(zip(zip(a, b, strict=True), face.tolist(), strict=True))
+
+
+def _conormals(points, triangles, loop, key: dict[tuple[int, int], int]) -> np.ndarray:
     """Unit outward conormals ``(k, 3)`` at the nodes of a boundary ``loop`` (in cell
     orientation): the mean of the outward normals of the two boundary edges at the node, each
-    ``edge × face normal``."""
+    ``edge × face normal`` (``key``: :func:`_boundary_faces`)."""
     nxt = np.roll(loop, -1)
-    key = {(int(a), int(b)): f for f, tri in enumerate(triangles) for a, b in _sides(tri)}
     faces = np.array([key[(int(a), int(b))] for a, b in zip(loop, nxt, strict=True)])
     corners = points[triangles[faces]]
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
@@ -149,19 +156,15 @@ def _conormals(points, triangles, loop) -> np.ndarray:
     return node / np.linalg.norm(node, axis=1, keepdims=True)
 
 
-def _sides(triangle: np.ndarray):
-    a, b, c = (int(v) for v in triangle)
-    return ((a, b), (b, c), (c, a))
-
-
 def _with_flange(tri: SurfaceMesh, loops, width: float, layers: int):
     """The mesh with a flange along every boundary loop, and the flange nodes' outwardness."""
     points, triangles = tri.points, tri.cells["triangle"]
     new_points, new_cells, outward = [], [], []
     count = len(points)
     depth = width * np.arange(1, layers + 1) / layers
+    key = _boundary_faces(triangles)
     for loop in loops:
-        conormal = _conormals(points, triangles, loop)
+        conormal = _conormals(points, triangles, loop, key)
         k = len(loop)
         rows = [loop]
         for d in depth:
