@@ -179,6 +179,19 @@ def test_fabric_band_command_writes_summary_and_report(tmp_path):
     assert bad.exit_code == 2 and "--samples" in error_line(bad)
 
 
+def test_fabric_band_command_leaves_a_runs_folder_alone(tmp_path):
+    """A run's folder keeps its own summary.json and report.html: the band, even with --force,
+    is refused there (``vares erect`` and the report read the run's summary.json)."""
+    out = tmp_path / "run"
+    made = run("example", "hypar", "-o", out, "--report", "-q")
+    assert made.exit_code == 0, made.stderr
+    before = {n: (out / n).read_bytes() for n in ("summary.json", "report.html")}
+    args = ("fabric", "band", "--example", "hypar", "--fabric", SHIPPED / "pes-batch-42.toml")
+    refused = run(*args, "--samples", "2", "-o", out, "--force")
+    assert refused.exit_code == 2 and "folder of a run" in error_line(refused)
+    assert {n: (out / n).read_bytes() for n in before} == before
+
+
 def test_fabric_fit_report_names_each_load_ratio(tmp_path):
     paths = sorted(SHIPPED.glob("pes-42-*"))
     report = tmp_path / "fit.html"

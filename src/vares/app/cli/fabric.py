@@ -326,6 +326,7 @@ def band(
         from ..inputs import load_input
         from ..job import Job
         from ..sections import InputOptions
+        from ..staging import listed
 
         files = list(inputs or [])
         if bool(files) == (example is not None):
@@ -371,6 +372,13 @@ def band(
                 f"{100 * c.fill:.3f} ± {100 * c.fill_std:.3f} %"
             )
         targets = [] if output is None else [output / "summary.json", output / "report.html"]
+        if output is not None:
+            owned = {p.resolve() for p in listed(output)}
+            if any(t.resolve() in owned for t in targets):
+                raise InputError(
+                    f"-o {output} is the folder of a run, whose files these would replace: "
+                    "write the band into a folder of its own"
+                )
         check_writable(targets, force)
         result = fabric_band(
             loaded.panels,
