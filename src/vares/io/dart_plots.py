@@ -59,8 +59,12 @@ def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
             ]
         )
         segments = []
+        if lines:
+            from scipy.spatial import cKDTree
+
+            node_normals, tree = _node_normals(mesh), cKDTree(mesh.points)
         for line in lines:  # the parts on the side seen, lifted off the surface a little
-            normals = _outward(mesh, line)
+            normals = node_normals[tree.query(line)[1]]
             lifted = line + 0.01 * size * normals
             seen = (normals @ towards > 0)[:-1] & (normals @ towards > 0)[1:]
             segments.append(np.stack([lifted[:-1], lifted[1:]], axis=1)[seen])
@@ -103,15 +107,11 @@ def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
     return fig
 
 
-def _outward(mesh: SurfaceMesh, line: np.ndarray) -> np.ndarray:
-    """Unit normals ``(k, 3)`` of the mesh at the nodes nearest the points of ``line``."""
-    from scipy.spatial import cKDTree
-
+def _node_normals(mesh: SurfaceMesh) -> np.ndarray:
+    """Unit normals ``(n, 3)`` of the mesh at its nodes (the sum of their cells' area vectors)."""
     triangles = mesh.cells["triangle"]
     vectors = mesh.area_vectors()
     normals = np.zeros_like(mesh.points)
     for k in range(3):
         np.add.at(normals, triangles[:, k], vectors)
-    normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
-    _, nearest = cKDTree(mesh.points).query(line)
-    return normals[nearest]
+    return normals / np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
