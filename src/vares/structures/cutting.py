@@ -213,10 +213,7 @@ def cut(
             callback=callback,
         )
         outlines = piece_outlines(plan.cut, result, cutting, allowances)
-        widths = [
-            width_across_warp(o.cut, r.fibres.warp)
-            for o, r in zip(outlines, result.results, strict=True)
-        ]
+        widths = _widths(outlines, result)
         needs = widths
         if plan.interlock:
             warps = [r.fibres.warp for r in result.results]
@@ -293,6 +290,14 @@ def _allowances(cutting: CutOptions, allowance: float, scale: float) -> dict[str
     }
 
 
+def _widths(outlines, structure: StructureResult) -> list[float]:
+    """Every cut outline's width across its pattern's warp (mesh units)."""
+    return [
+        width_across_warp(o.cut, r.fibres.warp)
+        for o, r in zip(outlines, structure.results, strict=True)
+    ]
+
+
 def _nest(outlines, widths, result: StructureResult, cutting: CutOptions, scale: float, plan):
     """The pieces nested on the roll, or None where they are not patterns or too wide: strips
     planned in pairs laid in pairs (:func:`~vares.structures.pair_nest.pair_nest`, where every
@@ -328,10 +333,7 @@ def with_patterns(cut_result: CutResult, structure: StructureResult) -> CutResul
     scale = unit_factor(cut_result.dxf_units, cut_result.units)
     allowances = _allowances(cutting, cut_result.allowance, scale)
     outlines = piece_outlines(cut_result.plan.cut, structure, cutting, allowances)
-    widths = [
-        width_across_warp(o.cut, r.fibres.warp)
-        for o, r in zip(outlines, structure.results, strict=True)
-    ]
+    widths = _widths(outlines, structure)
     nest = _nest(outlines, widths, structure, cutting, scale, cut_result.plan)
     return replace(
         cut_result,
