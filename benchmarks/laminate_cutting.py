@@ -101,7 +101,7 @@ def main() -> None:
               f"{darted.max_shear_before:.2f}° -> {after}, {len(darted.rounds)} solve(s) with "
               f"darts, {'cut with them' if drape.is_darted else 'cut whole'}, "
               f"converged {drape.converged}, {drape.seconds:.2f} s")  # fmt: skip
-    for path in laminate_files(job, result.labels):
+    for path in laminate_files(job, result.labels, nested=run.nest is not None):
         print(f"  {path.relative_to(out)}: {path.stat().st_size / 1024:.0f} KiB")
     if nest is None:
         print(f"not nested: {run.nest_error}")

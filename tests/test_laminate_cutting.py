@@ -260,6 +260,15 @@ def test_job_checks_the_cutting_options():
         laminate_files(clash)
 
 
+def test_the_files_of_a_run_not_nested_have_no_nest():
+    job = parse(job_text())
+    names = [p.name for p in laminate_files(job)]
+    assert "nest.dxf" in names
+    assert [n for n in names if n != "nest.dxf"] == [
+        p.name for p in laminate_files(job, nested=False)
+    ]
+
+
 def chromium(tmp_path, *arguments) -> subprocess.CompletedProcess:
     """Headless Chromium (Debian's) with a profile of its own."""
     browser = shutil.which("chromium")

@@ -63,12 +63,17 @@ __all__ = [
 ]
 
 
-def laminate_files(job: LaminateJob, labels: list[str] | None = None) -> list[Path]:
+def laminate_files(
+    job: LaminateJob, labels: list[str] | None = None, *, nested: bool = True
+) -> list[Path]:
     """The files a run writes (``labels``: the distinct drapes' labels, if known); the nest's
-    only with a ``roll_width``. Two plies whose names make the same file name are refused."""
+    only with a ``roll_width`` and unless ``nested`` is False (the plies were not nested, see
+    :attr:`LaminateRun.nest_error`). Two plies whose names make the same file name are
+    refused."""
     directory = job.directory
     names = ["laminate.json", "laminate.md", "laminate.vtu", "orientations.inp", "orientations.csv"]
-    names += ["plybook.html"] + (["nest.dxf"] if job.laminate.roll_width is not None else [])
+    nest = nested and job.laminate.roll_width is not None
+    names += ["plybook.html"] + (["nest.dxf"] if nest else [])
     paths = [directory / n for n in names]
     dxf: dict[str, str] = {}
     for ply in job.plies:
@@ -311,7 +316,7 @@ def cutting_markdown(run: LaminateRun) -> str:
 def write_laminate(folder: OutputFolder, job: LaminateJob, run: LaminateRun) -> None:
     """Write every file of :func:`laminate_files` into the staged folder."""
     result = run.result
-    paths = laminate_files(job, result.labels)
+    paths = laminate_files(job, result.labels, nested=run.nest is not None)
     for path in paths:
         folder.staged(path).parent.mkdir(parents=True, exist_ok=True)
     staged = {p.name: folder.staged(p) for p in paths if p.parent == job.directory}

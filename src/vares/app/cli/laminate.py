@@ -94,9 +94,8 @@ def laminate(
         if not quiet:
             _show(result)
             _show_cutting(run)
-            for path in laminate_files(job, result.labels):
-                if path.name != "nest.dxf" or run.nest is not None:  # not nested: not written
-                    console.print(f"  wrote {path}")
+            for path in laminate_files(job, result.labels, nested=run.nest is not None):
+                console.print(f"  wrote {path}")
         if not result.converged:
             raise typer.Exit(1)
 
