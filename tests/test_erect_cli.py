@@ -320,3 +320,35 @@ def test_a_cut_with_optimise_nests_the_optimised_pieces_once(tmp_path, monkeypat
     pattern = meshio.read(out / first / "pattern.obj").points[:, :2]
     ring = nested[0][0]  # the first piece's cut ring: its seam ring lies inside, allowance around
     assert np.ptp(ring, axis=0).max() == pytest.approx(np.ptp(pattern, axis=0).max(), rel=0.05)
+
+
+class _Erection:
+    """An erection's figures alone, as :func:`erection_comparison` reads them."""
+
+    surface_area, erected_area = 10.0, 9.5
+
+    def statistics(self, design=False):
+        stress = {"intended": 2.0, "mean": 1.5 if design else 1.9, "min": 1.0, "max": 2.5}
+        yarn = {**stress, "rms_deviation": 0.25}
+        return {
+            "stress": {"warp": yarn, "fill": yarn},
+            "wrinkled_area_fraction": 0.125,
+            "slack_area_fraction": 0.0 if design else 0.05,
+        }
+
+    def deviation(self):
+        return {"max": 0.0123, "rms": 0.00456}
+
+
+def test_erection_comparison_columns_design_shape_then_erected():
+    """Column by column, the figures of each state: no deviation on the design shape, the
+    erected surface's own after erection, and each state's area."""
+    from vares.app.erection_outputs import erection_comparison
+
+    titles, rows = erection_comparison(_Erection(), "m")
+    assert titles == ["on the design shape", "after erection"]
+    table = {label: values for label, *values in rows}
+    assert table["warp: mean"] == ["1.5", "1.9"]
+    assert table["slack area"] == ["0.0 %", "5.0 %"]
+    assert table["normal deviation, max / RMS (m)"] == ["0 / 0", "0.0123 / 0.00456"]
+    assert table["area (m²)"] == ["10", "9.5"]

@@ -113,13 +113,10 @@ def erection_comparison(
         if optimum is None
         else ("optimised_design_shape", "vares_erected", "optimised_erected")
     )
-    columns = [
-        (_TITLES[k], s, None if "design" in k else s["deviation"], s["area"])
-        for k, s in ((k, states[k]) for k in order)
-    ]
+    columns = [states[k] for k in order]
     rows: list[tuple[str, ...]] = []
     for yarn in ("warp", "fill"):
-        stats = [c[1]["stress"][yarn] for c in columns]
+        stats = [c["stress"][yarn] for c in columns]
         rows += [
             (f"{yarn}: intended", *(_number(s["intended"]) for s in stats)),
             (f"{yarn}: mean", *(_number(s["mean"]) for s in stats)),
@@ -127,18 +124,16 @@ def erection_comparison(
             (f"{yarn}: RMS from intended", *(_number(s["rms_deviation"], 3) for s in stats)),
         ]
     for key, label in (("wrinkled", "wrinkled area (uniaxial tension)"), ("slack", "slack area")):
-        rows.append((label, *(f"{100 * c[1][f'{key}_area_fraction']:.1f} %" for c in columns)))
+        rows.append((label, *(f"{100 * c[f'{key}_area_fraction']:.1f} %" for c in columns)))
+    deviations = [c["deviation"] for c in columns]  # zero on the design shape
     rows.append(
         (
             f"normal deviation, max / RMS ({units})",
-            *(
-                "0 / 0" if d is None else f"{_number(d['max'], 3)} / {_number(d['rms'], 3)}"
-                for _, _, d, _ in columns
-            ),
+            *(f"{_number(d['max'], 3)} / {_number(d['rms'], 3)}" for d in deviations),
         )
     )
-    rows.append((f"area ({units}²)", *(_number(a, 6) for *_, a in columns)))
-    return [c[0] for c in columns], rows
+    rows.append((f"area ({units}²)", *(_number(c["area"], 6) for c in columns)))
+    return [_TITLES[k] for k in order], rows
 
 
 def erection_files(directory: Path, report: bool = False) -> list[Path]:
