@@ -108,14 +108,17 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
     options = result.laminate.options
     allowance = float(options.trim_allowance)
     blanks = []
+    outlines: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {}  # per drape
     for ply in result.laminate.plies:
         drape = result.drape(ply.name)
         mesh, pattern = drape.blank_mesh, drape.blank_pattern
         coordinates = pattern.material_coordinates
-        loops = [coordinates[loop] for loop in mesh.boundary_loops()]
-        loops.sort(key=lambda r: -abs(ring_area(r)))
-        net = [r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)]
-        trim = extended_boundary(net, allowance)
+        if drape.label not in outlines:  # the plies of one drape share its outline
+            loops = [coordinates[loop] for loop in mesh.boundary_loops()]
+            loops.sort(key=lambda r: -abs(ring_area(r)))
+            net = [r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)]
+            outlines[drape.label] = net, extended_boundary(net, allowance)
+        net, trim = outlines[drape.label]
         node = int(np.argmin(np.linalg.norm(mesh.points - drape.seed, axis=1)))
         fibres = pattern.fibres
         o = ply.options
