@@ -192,6 +192,24 @@ def test_fabric_band_command_leaves_a_runs_folder_alone(tmp_path):
     assert {n: (out / n).read_bytes() for n in before} == before
 
 
+def test_fabric_band_command_writes_both_files_or_neither(tmp_path, monkeypatch):
+    """A report that cannot be made leaves the folder's earlier summary.json as it was (the
+    band's files are made before either is written)."""
+    out = tmp_path / "band"
+    args = ("fabric", "band", "--example", "hypar", "--fabric", SHIPPED / "pes-batch-42.toml")
+    args += ("--samples", "2", "--no-erect", "-o", out, "--force")
+    assert run(*args).exit_code == 0
+    before = (out / "summary.json").read_bytes()
+
+    def broken(*_):
+        raise RuntimeError("no report")
+
+    monkeypatch.setattr("vares.app.fabric_report.band_report", broken)
+    failed = run(*args, "--seed", "1")
+    assert failed.exit_code != 0 and "no report" in failed.stderr
+    assert (out / "summary.json").read_bytes() == before
+
+
 def test_fabric_fit_report_names_each_load_ratio(tmp_path):
     paths = sorted(SHIPPED.glob("pes-42-*"))
     report = tmp_path / "fit.html"

@@ -150,17 +150,20 @@ def fit(
             from ...io.fabric_plots import fabric_figures, figure_paths
 
             check_writable([p for *_, p in figure_paths(fitted, records, plots)], force)
+        pages = {}  # made before any file is written
+        if report is not None:
+            from ..fabric_report import fit_report
+
+            pages[report] = fit_report(fitted, records)
         write_text(output, text)
         _show(fitted)
         console.print(f"wrote {output}")
         if plots is not None:
             figures = fabric_figures(fitted, records, plots)
             console.print(f"drew {len(figures)} figures in {plots}")
-        if report is not None:
-            from ..fabric_report import fit_report
-
-            write_text(report, fit_report(fitted, records))
-            console.print(f"wrote {report}")
+        for path, page in pages.items():
+            write_text(path, page)
+            console.print(f"wrote {path}")
 
     guarded(body)
 
@@ -414,8 +417,9 @@ def band(
         if output is not None:
             output.mkdir(parents=True, exist_ok=True)
             summary = {**result.to_dict(), "units": loaded.units}
+            report = band_report(result, loaded.units)  # both made before either is written
             write_text(targets[0], json.dumps(summary, indent=2) + "\n")
-            write_text(targets[1], band_report(result, loaded.units))
+            write_text(targets[1], report)
             console.print(f"wrote {targets[0]} and {targets[1]}")
 
     guarded(body)
