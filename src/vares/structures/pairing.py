@@ -70,12 +70,8 @@ def split_lone_strip(plan: StripPlan, snap: float = 0.0) -> StripPlan:
     cut, points = plan.cut, plan.cut.mesh.points
     cells = cut.mesh.cells["triangle"]
     used = np.unique(cells[cut.panel_ids == index])
-    mine = set(used.tolist())
-    sides = []
-    for chain in cut.lines:
-        along = np.array([n for n in chain.tolist() if n in mine])
-        if len(along) >= 2:
-            sides.append(along)
+    sides = [chain[np.isin(chain, used)] for chain in cut.lines]
+    sides = [along for along in sides if len(along) >= 2]
     if len(sides) != 2:
         return plan
     start, end = (int(np.searchsorted(used, _half_way(c, points))) for c in sides)
