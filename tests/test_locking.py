@@ -27,6 +27,9 @@ from vares.mechanics.problem import Problem
 from vares.mechanics.yarn_smoothing import paired_domains
 from vares.solver.options import SolveOptions
 
+#: The continuation for E/G = 1e6: a stage per decade.
+DECADES = (1e2, 1e3, 1e4, 1e5)
+
 LAWS = {
     "orthotropic": OrthotropicStVenantKirchhoff(100.0, 80.0, 1.0, 0.2),
     "ncf": NonCrimpFabric.from_moduli(100.0, 80.0, 1.0),
@@ -358,10 +361,11 @@ def test_blank_extent_of_a_rectangle_along_its_yarns_and_diagonals():
 
 def test_continuation_reaches_yarn_to_shear_1e6_from_the_default_start_without_locking():
     """The hemisphere of 2,400 irregular triangles at E/G = 1e6 from the solver's default start,
-    the warp aligned with x at every stage of 1e2 → 1e4 → 1e6: converged, the four 45°
-    meridians within 1.8° of each other and 2° of the net (measured 1.70° and 1.84°; the
+    the warp aligned with x at every stage of 1e2 → 1e3 → 1e4 → 1e5 → 1e6: converged, the four
+    45° meridians within 1.8° of each other and 2° of the net (measured 1.70° and 1.84°; the
     kinematic net on this mesh spreads by 2.6°), where cell by cell they spread by more than
-    9° (measured 12.0°). Measured: 39 + 48 + 52 iterations."""
+    9° (measured 12.0°). Measured: 39 + 27 + 11 + 5 + 3 = 85 iterations (through 1e2 and 1e4
+    without the extrapolation: 39 + 48 + 52 = 139)."""
     mesh = irregular_cap(100.0, 90.0, 20, 0.3, 1)
     stiff = OrthotropicStVenantKirchhoff(E1=1e6, E2=1e6, G12=1.0, nu12=0.0)
     result = solve_yarn_strain(
@@ -370,13 +374,14 @@ def test_continuation_reaches_yarn_to_shear_1e6_from_the_default_start_without_l
         yarn_strain="paired",
         yarn_stabilisation=1e-5,
         warp_direction=(1, 0, 0),
-        continuation=(1e2, 1e4),
+        continuation=DECADES,
     )
     assert result.converged
-    assert [s.ratio for s in result.stages] == [1e2, 1e4, 1e6]
-    assert [s.stabilisation for s in result.stages] == pytest.approx([0.1, 1e-3, 1e-5])
+    assert [s.ratio for s in result.stages] == [*DECADES, 1e6]
+    assert [s.stabilisation for s in result.stages] == pytest.approx([0.1, 1e-2, 1e-3, 1e-4, 1e-5])
     assert all(s.converged and s.aligned for s in result.stages)
-    assert result.iterations == sum(s.iterations for s in result.stages) < 200
+    assert result.iterations == sum(s.iterations for s in result.stages) < 100
+    assert result.stages[-1].iterations <= 5  # from the extrapolation of 1e4 and 1e5
     assert abs(result.fibres.warp[1]) < 1e-12  # returned with the warp along +x
     table = meridian_shear(mesh, cell_shear_angle(mesh, result.coordinates, stiff, result.fibres))
     assert (table.max(axis=0) - table.min(axis=0)).max() < 1.8
@@ -392,7 +397,7 @@ def test_continuation_reaches_yarn_to_shear_1e6_from_the_default_start_without_l
 def test_continuation_converges_where_the_direct_stiff_solve_does_not():
     """A cap of 600 cells at E/G = 1e6, pairs of nodes, warp aligned, the default start: solved
     directly the warp alignment does not converge (877 iterations measured); through 1e2 and
-    1e4 it does, in 73 (13 + 44 + 16)."""
+    1e4 it does, in 64 (13 + 36 + 15; the last stage from the extrapolation of the two)."""
     mesh = irregular_cap(100.0, 90.0, 10, 0.3, 1)
     stiff = OrthotropicStVenantKirchhoff(E1=1e6, E2=1e6, G12=1.0, nu12=0.0)
     settings = {"yarn_strain": "paired", "yarn_stabilisation": 1e-5, "warp_direction": (1, 0, 0)}
@@ -401,3 +406,90 @@ def test_continuation_converges_where_the_direct_stiff_solve_does_not():
     direct = solve_yarn_strain(mesh, stiff, **settings)
     assert not direct.converged
     assert direct.iterations > 4 * staged.iterations
+
+
+def test_the_continuation_is_an_option_of_the_api_job_files_and_command_line(tmp_path):
+    """``yarn_continuation`` is a solve option: ``vares.solve``, a job file's ``[fibres]`` table
+    and ``--yarn-continuation`` give the pattern of ``solve_yarn_strain(continuation=...)`` (a cap
+    of 600 cells at E/G = 1e6 from the default start); the stages' records lead its history and
+    path, the stages from the third on start from the extrapolation of the two before; measured
+    13 + 16 + 8 + 5 + 3 = 45 iterations (through 1e2 and 1e4 alone: 13 + 36 + 15 = 64)."""
+    import json
+
+    import meshio
+    from conftest import run
+
+    import vares
+
+    mesh = irregular_cap(100.0, 90.0, 10, 0.3, 1)
+    stiff = OrthotropicStVenantKirchhoff(E1=1e6, E2=1e6, G12=1.0, nu12=0.0)
+    settings = {"yarn_strain": "paired", "yarn_stabilisation": 1e-5, "warp_direction": (1, 0, 0)}
+    staged = solve_yarn_strain(mesh, stiff, continuation=DECADES, **settings)
+    assert staged.converged and staged.iterations < 60
+    assert [s.ratio for s in staged.stages] == [*DECADES, 1e6]
+    assert [s.extrapolated for s in staged.stages] == [False, False, True, True, True]
+    assert staged.stages[-1].iterations <= 5
+    result = vares.solve(mesh, stiff, yarn_continuation=DECADES, **settings)
+    assert result.converged and result.options.yarn_continuation == DECADES
+    np.testing.assert_allclose(result.material_coordinates, staged.coordinates, atol=1e-12)
+    assert result.iterations == staged.iterations
+    assert result.strategy[0] == "E/G 100: globalised newton"
+    assert result.strategy[-1] == "warp alignment"  # the law's own solve last
+    assert {r.strategy.split(":")[0] for r in result.history if ":" in r.strategy} == {
+        "E/G 100",
+        "E/G 1e+03",
+        "E/G 1e+04",
+        "E/G 1e+05",
+    }
+    source = tmp_path / "cap.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[input]\nmesh = "cap.obj"\n\n[material]\nlaw = "orthotropic"\nE1 = 1e6\nE2 = 1e6\n'
+        "G12 = 1.0\nnu12 = 0.0\n\n[fibres]\nwarp_direction = [1.0, 0.0, 0.0]\n"
+        'yarn_strain = "paired"\nyarn_stabilisation = 1e-5\n'
+        "yarn_continuation = [100.0, 1000.0, 1e4, 1e5]\n\n"
+        '[output]\ndirectory = "job"\npreviews = false\n'
+    )
+    ran = run("run", job, "-q")
+    assert ran.exit_code == 0, ran.stderr
+    summary = json.loads((tmp_path / "job" / "summary.json").read_text())
+    assert summary["converged"] and summary["options"]["yarn_continuation"] == list(DECADES)
+    written = meshio.read(tmp_path / "job" / "pattern.obj").points[:, :2]
+    np.testing.assert_allclose(written, staged.coordinates, atol=1e-6)
+    flags = ["--material", "orthotropic", "--E1", "1e6", "--E2", "1e6", "--G12", "1"]
+    flags += ["--nu12", "0", "--warp-direction", "1,0,0", "--yarn-strain", "paired"]
+    flags += ["--yarn-stabilisation", "1e-5", "--no-previews", "-q"]
+    ran = run(
+        "pattern", source, "-o", tmp_path / "p", *flags, "--yarn-continuation", "1e2,1e3,1e4,1e5"
+    )
+    assert ran.exit_code == 0, ran.stderr
+    written = meshio.read(tmp_path / "p" / "pattern.obj").points[:, :2]
+    np.testing.assert_allclose(written, staged.coordinates, atol=1e-6)
+
+
+def test_continuation_options_are_refused_where_they_cannot_apply(tmp_path):
+    """Not ascending: refused by the options (and by the command line, naming the flag); a law
+    of other invariants, or ratios not below the law's: refused by the solve."""
+    from conftest import error_line, run
+
+    import vares
+    from vares.options import OptionsError
+
+    mesh = irregular_cap(100.0, 40.0, 3, 0.3, 1)
+    with pytest.raises(OptionsError, match="ascending"):
+        SolveOptions(yarn_continuation=(1e3, 1e2))
+    with pytest.raises(OptionsError, match="ascending"):
+        SolveOptions(yarn_continuation=(0.0, 1e2))
+    with pytest.raises(OptionsError, match="needs a fibre law"):
+        vares.solve(mesh, NeoHooke(1.0, 0.3), yarn_continuation=(1e2,))
+    law = OrthotropicStVenantKirchhoff(1e3, 1e3, 1.0, 0.0)
+    with pytest.raises(OptionsError, match="below the law's"):
+        vares.solve(mesh, law, yarn_continuation=(1e2, 1e3))
+    import meshio
+
+    source = tmp_path / "cap.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+    ran = run("pattern", source, "-o", tmp_path / "p", "--yarn-continuation", "1e3,1e2", "-q")
+    assert ran.exit_code == 2
+    assert "--yarn-continuation must be ascending" in error_line(ran)

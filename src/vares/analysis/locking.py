@@ -4,7 +4,8 @@ along the meridians of a cap (the intra-ply shear locking check of DESIGN.md §8
 :func:`solve_yarn_strain` is :func:`vares.solve` with ``yarn_strain`` set (the solve assembles
 over the problem's connectivity), returning the problem beside the pattern; with
 ``continuation`` it reaches a stiff law through softer ones (:class:`ScaledYarns`, the yarn
-part of the law scaled), each stage started from the last pattern. :func:`meridian_shear`
+part of the law scaled; :mod:`vares.solver.continuation`), as ``vares.solve(...,
+yarn_continuation=...)`` does. :func:`meridian_shear`
 samples a per-cell field along meridians of a surface of revolution about the z axis;
 :func:`blank_extent` measures a pattern along its yarns and diagonals.
 """
@@ -22,6 +23,7 @@ from ..mechanics.fields import cell_fields
 from ..mechanics.problem import Problem
 from ..mechanics.yarn_laws import ScaledYarns, yarn_to_shear_ratio
 from ..solver.api import solve
+from ..solver.continuation import ContinuationStage, solve_in_stages
 from ..solver.options import SolveOptions
 from ..solver.result import IterationRecord
 
@@ -35,19 +37,6 @@ __all__ = [
     "solve_yarn_strain",
     "yarn_to_shear_ratio",
 ]
-
-
-@dataclass
-class ContinuationStage:
-    """One stage of a continuation: its yarn-to-shear ratio, stabilisation share, whether the
-    warp was aligned (else the rotation of the last stage held), and how the solve went."""
-
-    ratio: float
-    stabilisation: float
-    aligned: bool
-    converged: bool
-    iterations: int
-    elapsed: float
 
 
 @dataclass
@@ -92,53 +81,34 @@ def solve_yarn_strain(
 
     ``continuation``: yarn-to-shear ratios ``E/G`` (ascending, below the law's own,
     :func:`yarn_to_shear_ratio`) solved first, the law's yarn part scaled to each
-    (:class:`ScaledYarns`), each stage from the last pattern, the law itself last (e.g.
-    ``(1e2, 1e4)`` for a law of E/G = 1e6). Each stage keeps the per-cell yarn stiffness
+    (:class:`ScaledYarns`), each stage from the last pattern (from the third on, from the
+    extrapolation in ``1/ratio`` of the two before), the law itself last (e.g.
+    ``(1e2, 1e3, 1e4, 1e5)`` for a law of E/G = 1e6): :func:`vares.solve` with
+    ``yarn_continuation`` (:func:`vares.solver.continuation.solve_in_stages`), which always
+    aligns the warp. Each stage keeps the per-cell yarn stiffness
     ``yarn_stabilisation × E`` of the law (its share ``yarn_stabilisation × E/E_stage``, at most
     0.5). With ``warp_direction`` the warp is aligned at the stages of ratio up to
     ``align_up_to`` (default: every stage); the later ones hold the rotation and yarn angle of
     the last aligned pattern. The iterations and seconds returned are the stages' sums; each
     stage is in ``stages``.
     """
-    ratio = yarn_to_shear_ratio(material) if len(continuation) else 0.0
-    ratios = [float(r) for r in continuation]
-    if any(not np.isfinite(r) or r <= 0.0 for r in ratios) or np.any(np.diff(ratios) <= 0.0):
-        raise ValueError(f"continuation must be ascending positive ratios; got {ratios}")
-    if ratios and ratios[-1] >= ratio:
-        raise ValueError(
-            f"continuation ratios must lie below the law's yarn-to-shear ratio {ratio:.3g}; "
-            f"got {ratios[-1]:.3g}"
+    settings = {"yarn_strain": yarn_strain, "yarn_stabilisation": yarn_stabilisation}
+    if warp_direction is not None:
+        settings["warp_direction"] = tuple(warp_direction)
+    chosen = (options or SolveOptions()).replace(**settings, yarn_continuation=tuple(continuation))
+
+    def solve_one(law, stage_options, start):
+        return solve(
+            mesh, law, thickness, prestress=prestress, options=stage_options, initial_guess=start
         )
-    base = (options or SolveOptions()).replace(yarn_strain=yarn_strain)
-    direction = None if warp_direction is None else tuple(warp_direction)
-    stages: list[ContinuationStage] = []
-    history: list[IterationRecord] = []
-    guess, held_angle = initial_guess, None
-    for stage_ratio in [*ratios, None]:
-        law = material if stage_ratio is None else ScaledYarns(material, stage_ratio / ratio)
-        scale = 1.0 if stage_ratio is None else ratio / stage_ratio
-        share = yarn_stabilisation if stage_ratio is None else min(yarn_stabilisation * scale, 0.5)
-        shown = ratio if stage_ratio is None else stage_ratio
-        aligned = direction is not None and (align_up_to is None or shown <= align_up_to)
-        stage_options = base.replace(yarn_stabilisation=share)
-        if aligned:
-            stage_options = stage_options.replace(warp_direction=direction)
-        elif held_angle is not None:
-            stage_options = stage_options.replace(warp_direction=None, warp_angle=held_angle)
-        elif direction is not None:
-            stage_options = stage_options.replace(warp_direction=direction)
-            aligned = True
-        result = solve(
-            mesh, law, thickness, prestress=prestress, options=stage_options, initial_guess=guess
+
+    if chosen.yarn_continuation:
+        result, stages = solve_in_stages(
+            solve_one, mesh, material, chosen, initial_guess, align_up_to=align_up_to
         )
-        stages.append(
-            ContinuationStage(
-                shown, share, aligned, result.converged, result.iterations, result.elapsed
-            )
-        )
-        history.extend(result.history)
-        guess = result.material_coordinates
-        held_angle = float(np.degrees(np.arctan2(result.fibres.warp[1], result.fibres.warp[0])))
+    else:
+        result = solve_one(material, chosen, initial_guess)
+        stages = []
     problem = Problem(
         mesh,
         material,
@@ -146,7 +116,7 @@ def solve_yarn_strain(
         fibres=result.fibres,
         prestress=prestress,
         yarn_strain=yarn_strain,
-        yarn_stabilisation=stage_options.yarn_stabilisation,
+        yarn_stabilisation=yarn_stabilisation,
     )
     return SmoothedSolve(
         result.material_coordinates,
@@ -154,9 +124,9 @@ def solve_yarn_strain(
         problem,
         result.converged,
         result.reason,
-        sum(s.iterations for s in stages),
-        sum(s.elapsed for s in stages),
-        history,
+        result.iterations,
+        result.elapsed,
+        result.history,
         stages,
     )
 

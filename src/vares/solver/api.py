@@ -23,6 +23,7 @@ from ..mechanics.problem import Problem
 from ..mechanics.rigid import rigid_modes
 from ..options import split_settings, takes_options
 from .alignment import align_warp, fibre_angle, initial_fibres, rotated
+from .continuation import solve_in_stages
 from .linear import get_solver, quiet_blas
 from .newton import Failure, NewtonContext, describe_cells
 from .options import SolveOptions
@@ -92,7 +93,18 @@ def solve(
     (options,) = split_settings(settings, [options or SolveOptions()])
     with quiet_blas():
         warm_up = _load_kernels(mesh, material, options.linear_solver)
-        result = _solve(mesh, material, thickness, prestress, options, callback, given)
+        if options.yarn_continuation:  # the law's yarns reached through softer ones
+            result, _ = solve_in_stages(
+                lambda law, stage, start: _solve(
+                    mesh, law, thickness, prestress, stage, callback, start
+                ),
+                mesh,
+                material,
+                options,
+                given,
+            )
+        else:
+            result = _solve(mesh, material, thickness, prestress, options, callback, given)
     result.warm_up = warm_up
     return result
 

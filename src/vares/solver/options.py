@@ -8,6 +8,7 @@ written. :func:`vares.solve` takes its fields as keyword arguments, job files ho
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 
 from ..mechanics.yarn_smoothing import YARN_STRAINS
 from ..options import Options, OptionsError, option
@@ -70,6 +71,14 @@ class SolveOptions(Options):
         section="fibres",
         minimum=0,
     )
+    yarn_continuation: tuple[float, ...] = option(
+        (),
+        "floats",
+        "Stiff fibre laws: yarn-to-shear ratios E/G 'r1,r2,…' (ascending, below the law's) "
+        "solved first with the law's yarns softened to each, every stage from the last "
+        "pattern, the law itself last; e.g. 1e2,1e3,1e4,1e5 for E/G = 1e6 (docs/locking.md).",
+        section="fibres",
+    )
     strategy: str = option(
         "auto",
         "str",
@@ -129,6 +138,11 @@ class SolveOptions(Options):
     )
 
     def check(self) -> None:
+        ratios = self.yarn_continuation
+        if any(r <= 0.0 for r in ratios) or any(b <= a for a, b in pairwise(ratios)):
+            raise OptionsError(
+                "yarn_continuation", f"must be ascending positive ratios; got {list(ratios)}"
+            )
         if self.warp_direction is not None and self.orientation == "free":
             raise OptionsError(
                 None, "a warp direction fixes the orientation; it cannot also be free"
