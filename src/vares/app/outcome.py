@@ -20,7 +20,7 @@ from .sections import STRUCTURE_MARK_SPACING
 if TYPE_CHECKING:  # made (and their modules imported) only when a job asks for them
     from ..analysis.drape import PlyDrape
     from ..analysis.erection_optimum import OptimisedPatterns
-    from .run_band import RunBand
+    from .band_result import RunBand
 
 __all__ = ["JobOutcome", "PanelOutcome"]
 

@@ -27,7 +27,8 @@ from ..materials.fabric_file import ConstantScatter, constant_scatter
 from ..materials.presets import FabricPreset, fabric, file_fabric
 from ..solver.options import SolveOptions
 from ..structures.panels import Panel
-from .fabric_band import FabricBand, fabric_band, structure_figures
+from .band_result import RunBand
+from .fabric_band import fabric_band, structure_figures
 from .job import Job, JobError
 from .outcome import JobOutcome
 
@@ -48,32 +49,6 @@ class BandInputs:
     constants: ConstantScatter | None
     prestress: tuple[float, ...]
     notes: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
-class RunBand:
-    """The band of a run (:func:`run_band`), or why there is none (``reason``)."""
-
-    path: Path
-    band: FabricBand | None
-    reason: str | None = None
-    nominal_difference: float | None = None
-
-    def to_dict(self, units: str) -> dict[str, Any]:
-        """The ``scatter`` section of ``summary.json`` / ``structure.json``."""
-        head: dict[str, Any] = {"fabric_file": str(self.path)}
-        if self.band is None:
-            return head | {"converged": False, "reason": self.reason}
-        return (
-            head
-            | self.band.to_dict()
-            | {
-                "units": units,
-                "nominal_case": "the run's own patterns solved again with the same law and options",
-                "nominal_difference": self.nominal_difference,
-                "where": "in this process",
-            }
-        )
 
 
 def check_run_band(job: Job) -> BandInputs | None:

@@ -35,15 +35,14 @@ import numpy as np
 from ..analysis.darts import DartedPattern
 from ..analysis.drape import PlyDrape
 from ..geometry.mesh import SurfaceMesh
-from ..materials import Hyperelastic
 from ..options import OptionsError, split_settings, takes_options
 from ..solver.result import PatternResult
 from .laminate_options import LaminateOptions, PlyOptions
 from .laminate_pairs import PAIR_VALUES, PairCheck, blank_used_for, draped_yarns, pair_check
+from .laminate_plies import Ply, PlyDrapeResult, darts_used
 from .laminate_regions import cell_blocks, ply_warp, region_cells, seed_on_mould, submesh
 from .laminate_tasks import (
     dart_task,
-    darts_used,
     drape_key,
     drape_tasks,
     on_mould_cells,
@@ -75,21 +74,6 @@ PARALLEL_CELLS = 4000
 
 
 @dataclass(frozen=True)
-class Ply:
-    """A ply: its :class:`PlyOptions`, its material (a hyperelastic law, thickness 1) and the
-    dart lines of its own (``(k, 3)`` polylines on or near the mould, mouth or tip first; e.g.
-    the curves of its ``dart_lines`` file), if any."""
-
-    options: PlyOptions
-    material: Hyperelastic
-    dart_lines: tuple[np.ndarray, ...] | None = None
-
-    @property
-    def name(self) -> str:
-        return self.options.name
-
-
-@dataclass(frozen=True)
 class Laminate:
     """A stack of plies, bottom (mould side) first, and the options they share."""
 
@@ -106,101 +90,6 @@ class Laminate:
         orders = [p.options.drop_off for p in self.plies if p.options.drop_off is not None]
         if len(set(orders)) != len(orders):
             raise OptionsError("drop_off", f"must differ from ply to ply; got {orders}")
-
-
-@dataclass
-class PlyDrapeResult:
-    """One distinct drape of a laminate (the plies ``plies`` share it).
-
-    ``cells`` ``(k,)``: the mould cells it covers (global cell order); ``mesh`` the ply's mesh
-    (those cells; the whole mould when the ply has no region) and ``nodes`` ``(n_ply,)`` its nodes'
-    indices on the mould. ``seed``, ``warp_direction``, ``normal`` ``(3,)``: where it is laid and
-    the warp there. ``pattern``: the mechanical drape (:func:`vares.solve`, warp along +x);
-    ``kinematic``: the pin-jointed net beside it (``None`` when not asked for or failed, with
-    ``kinematic_error``). ``darted``: the ply with its darts open (``None`` without darts asked
-    for; its ``after`` is ``None`` when none was needed or placed; the ply is cut with them when
-    :attr:`is_darted`) and ``locking_angle`` (degrees).
-    Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``, ``fill`` (unit erected
-    yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
-    laid (the darted pattern's, each mould cell the area-weighted mean of its pieces in the
-    opened mesh: :func:`~vares.structures.laminate_tasks.on_mould_cells`), and the kinematic
-    ``kinematic_warp``, ``kinematic_fill``, ``kinematic_shear_angle``. The pair check uses
-    ``pattern``, the ply without darts, on the mould's cells.
-    """
-
-    label: str
-    plies: list[str]
-    orientation: float
-    cells: np.ndarray
-    nodes: np.ndarray
-    mesh: SurfaceMesh
-    seed: np.ndarray
-    warp_direction: np.ndarray
-    normal: np.ndarray
-    material: Hyperelastic
-    pattern: PatternResult
-    warp: np.ndarray
-    fill: np.ndarray
-    shear_angle: np.ndarray
-    kinematic: PlyDrape | None
-    kinematic_error: str | None
-    kinematic_warp: np.ndarray
-    kinematic_fill: np.ndarray
-    kinematic_shear_angle: np.ndarray
-    seconds: float
-    locking_angle: float = float("nan")
-    darted: DartedPattern | None = None
-
-    @property
-    def is_darted(self) -> bool:
-        """Whether the ply is cut open along darts: asked for, placed, and lowering its largest
-        shear (:func:`~vares.structures.laminate_tasks.darts_used`)."""
-        return darts_used(self.darted)
-
-    @property
-    def blank_mesh(self) -> SurfaceMesh:
-        """The mesh of the blank as cut: the ply's mesh opened along its darts, if any."""
-        return self.darted.slits.mesh if self.is_darted else self.mesh
-
-    @property
-    def blank_pattern(self) -> PatternResult:
-        """The pattern of the blank as cut (of :attr:`blank_mesh`)."""
-        return self.darted.after if self.is_darted else self.pattern
-
-    @property
-    def converged(self) -> bool:
-        return bool(self.pattern.converged and self.blank_pattern.converged)
-
-    def summary(self) -> dict[str, Any]:
-        """The numbers for a summary file."""
-        area = self.mesh.cell_areas()
-        shear = self.shear_angle[self.cells]
-        data: dict[str, Any] = {
-            "label": self.label,
-            "plies": self.plies,
-            "orientation": self.orientation,
-            "seed": self.seed,
-            "warp_direction": self.warp_direction,
-            "cells": len(self.cells),
-            "area": float(area.sum()),
-            "converged": self.converged,
-            "reason": self.pattern.reason,
-            "iterations": self.pattern.iterations,
-            "energy": self.pattern.energy,
-            "warp_deviation": self.pattern.warp_deviation,
-            "seconds": self.seconds,
-            "max_shear": float(np.nanmax(np.abs(shear))),
-            "mean_abs_shear": float(area @ np.abs(shear) / area.sum()),
-        }
-        if self.kinematic is not None:
-            data["kinematic_drape"] = self.kinematic.summary()
-            undarted = self.pattern.fields["shear_angle"]  # the net is not darted
-            data["kinematic_drape"]["against_pattern"] = self.kinematic.comparison(undarted, area)
-        elif self.kinematic_error is not None:
-            data["kinematic_drape"] = {"error": self.kinematic_error}
-        data["locking_angle"] = self.locking_angle
-        data["darts"] = None if self.darted is None else self.darted.summary()
-        return data
 
 
 @dataclass

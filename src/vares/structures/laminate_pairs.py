@@ -19,7 +19,7 @@ from ..geometry.elements import ELEMENTS, inverse
 from ..geometry.mesh import SurfaceMesh
 
 if TYPE_CHECKING:
-    from .laminate import PlyDrapeResult
+    from .laminate_plies import PlyDrapeResult
 
 __all__ = [
     "PAIR_TITLES",

@@ -10,10 +10,10 @@ cells a dart crosses are split, and every node of a dart but its tip gets a twin
 has more cells than the ply's. Each of its cells lies in one cell of the ply's mesh
 (:attr:`~vares.geometry.slits.SlitMesh.cell_origin`); a cell no dart crosses is that very
 triangle. A ply is cut with its darts only when they lower its largest shear
-(:func:`darts_used`): darts that leave it as high or higher (the rib's, docs/composites.md) are
-reported, and the ply is cut whole. :func:`on_mould_cells` gives every cell of the ply's mesh
-the area-weighted mean of its pieces (unit vectors normalised again), which is the piece's own
-value where the cell is whole.
+(:func:`~vares.structures.laminate_plies.darts_used`): darts that leave it as high or higher
+(the rib's, docs/composites.md) are reported, and the ply is cut whole.
+:func:`on_mould_cells` gives every cell of the ply's mesh the area-weighted mean of its pieces
+(unit vectors normalised again), which is the piece's own value where the cell is whole.
 """
 
 from __future__ import annotations
@@ -21,11 +21,11 @@ from __future__ import annotations
 import hashlib
 import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from ..analysis.darts import DartedPattern, solve_with_darts
+from ..analysis.darts import solve_with_darts
 from ..analysis.drape import drape_ply
 from ..geometry.mesh import SurfaceMesh
 from ..materials.forming import locking_angle
@@ -33,9 +33,7 @@ from ..options import OptionsError
 from ..parallel import process_pool
 from ..solver.api import solve
 from .laminate_options import LaminateOptions, PlyOptions
-
-if TYPE_CHECKING:
-    from .laminate import Ply
+from .laminate_plies import Ply, darts_used
 
 __all__ = [
     "dart_task",
@@ -89,14 +87,6 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
         "error": error,
         "seconds": time.perf_counter() - started,
     }
-
-
-def darts_used(darted: DartedPattern | None) -> bool:
-    """Whether a ply is cut with the darts of ``darted``: some were opened, the solve with them
-    converged, and they lower the ply's largest shear."""
-    if darted is None or darted.after is None or not darted.after.converged:
-        return False
-    return bool(darted.max_shear_after < darted.max_shear_before)
 
 
 def drape_tasks(

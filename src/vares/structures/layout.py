@@ -34,7 +34,6 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -44,6 +43,7 @@ from ..geometry.mesh import SurfaceMesh
 from ..geometry.refine import MAX_ROUNDS, refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
 from .panels import Panel, split_panels
+from .strip_plan import StripPlan
 from .widths import pattern_direction, strip_widths
 
 __all__ = [
@@ -71,44 +71,6 @@ APART = 0.2
 _SHORTEST = 0.1
 #: Further refinements at most, when planned lines meet, before plane sections replace geodesics.
 _RETRIES = 2
-
-
-@dataclass
-class StripPlan:
-    """Strips cut from a surface.
-
-    ``cut`` is the cut mesh (panel ids in strip order), ``panels`` the strips (``strip-1`` …),
-    ``lines`` the cutting lines as computed (geodesics or plane sections, on the mesh the cut
-    started from) and ``warps`` the 3D direction along every strip. ``widths`` are the flattened
-    strips' extents across their warps, allowances included (mesh units); ``evaluations`` counts
-    the layouts tried, ``history`` the widest strip for every number of gaps between lines tried.
-    ``refinements`` is the number of rounds the surface was refined on its own faces before it
-    was cut (``input_cells`` its triangles before, ``refined_cells`` after), and
-    ``replaced_geodesics`` the number of geodesics replaced by their plane sections (module docs).
-    With ``interlock`` the strips are planned in pairs (``widths`` are pairs' widths);
-    ``lengths`` are the strips' extents along the warp, ``straight_pairs`` the widths their
-    pairs would need with one seam along the warp, ``compared`` the roll estimates of both
-    plans (:mod:`.pairing`) and ``split`` the two halves of a strip cut across, if any.
-    """
-
-    cut: CutMesh
-    panels: list[Panel]
-    lines: list[SurfaceLine]
-    warps: list[np.ndarray]
-    widths: list[float]
-    family: LineFamily | None = None
-    evaluations: int = 0
-    history: list[tuple[int, float]] = field(default_factory=list)  # (gaps, widest)
-    refinements: int = 0
-    input_cells: int = 0
-    refined_cells: int = 0
-    replaced_geodesics: int = 0
-    interlock: bool = False
-    lengths: list[float] = field(default_factory=list)
-    straight_pairs: list[float] = field(default_factory=list)
-    compared: dict[str, tuple[int, float]] = field(default_factory=dict)
-    split: tuple[int, int] | None = None
-    straight_warp: bool = False
 
 
 def plan_strips(

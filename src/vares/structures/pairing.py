@@ -16,8 +16,8 @@ import numpy as np
 
 from ..geometry.cross_cut import cut_across
 from ..geometry.surface_lines import SurfaceLine, geodesic_lines
-from .layout import StripPlan
 from .panels import split_panels
+from .strip_plan import StripPlan
 from .widths import pair_width, roll_estimate
 
 __all__ = ["SAVING", "choose_plan", "pair_widths", "split_lone_strip"]

@@ -26,7 +26,7 @@ from ..geometry.surface_lines import triangulated
 from .panels import width_across_warp
 
 if TYPE_CHECKING:
-    from .layout import StripPlan
+    from .strip_plan import StripPlan
 
 __all__ = [
     "along_straight_side",

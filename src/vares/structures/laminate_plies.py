@@ -1,0 +1,138 @@
+"""A laminate's plies and what draping one gives: :class:`Ply` (its options, material and dart
+lines) and :class:`PlyDrapeResult` (one distinct drape, shared by the plies that differ only in
+name and drop-off). Their own module so that the tasks (:mod:`.laminate_tasks`) and the pair
+check (:mod:`.laminate_pairs`) take them without importing the laminate (:mod:`.laminate`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..analysis.darts import DartedPattern
+from ..analysis.drape import PlyDrape
+from ..geometry.mesh import SurfaceMesh
+from ..materials import Hyperelastic
+from ..solver.result import PatternResult
+from .laminate_options import PlyOptions
+
+__all__ = ["Ply", "PlyDrapeResult", "darts_used"]
+
+
+@dataclass(frozen=True)
+class Ply:
+    """A ply: its :class:`PlyOptions`, its material (a hyperelastic law, thickness 1) and the
+    dart lines of its own (``(k, 3)`` polylines on or near the mould, mouth or tip first; e.g.
+    the curves of its ``dart_lines`` file), if any."""
+
+    options: PlyOptions
+    material: Hyperelastic
+    dart_lines: tuple[np.ndarray, ...] | None = None
+
+    @property
+    def name(self) -> str:
+        return self.options.name
+
+
+def darts_used(darted: DartedPattern | None) -> bool:
+    """Whether a ply is cut with the darts of ``darted``: some were opened, the solve with them
+    converged, and they lower the ply's largest shear."""
+    if darted is None or darted.after is None or not darted.after.converged:
+        return False
+    return bool(darted.max_shear_after < darted.max_shear_before)
+
+
+@dataclass
+class PlyDrapeResult:
+    """One distinct drape of a laminate (the plies ``plies`` share it).
+
+    ``cells`` ``(k,)``: the mould cells it covers (global cell order); ``mesh`` the ply's mesh
+    (those cells; the whole mould when the ply has no region) and ``nodes`` ``(n_ply,)`` its nodes'
+    indices on the mould. ``seed``, ``warp_direction``, ``normal`` ``(3,)``: where it is laid and
+    the warp there. ``pattern``: the mechanical drape (:func:`vares.solve`, warp along +x);
+    ``kinematic``: the pin-jointed net beside it (``None`` when not asked for or failed, with
+    ``kinematic_error``). ``darted``: the ply with its darts open (``None`` without darts asked
+    for; its ``after`` is ``None`` when none was needed or placed; the ply is cut with them when
+    :attr:`is_darted`) and ``locking_angle`` (degrees).
+    Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``, ``fill`` (unit erected
+    yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
+    laid (the darted pattern's, each mould cell the area-weighted mean of its pieces in the
+    opened mesh: :func:`~vares.structures.laminate_tasks.on_mould_cells`), and the kinematic
+    ``kinematic_warp``, ``kinematic_fill``, ``kinematic_shear_angle``. The pair check uses
+    ``pattern``, the ply without darts, on the mould's cells.
+    """
+
+    label: str
+    plies: list[str]
+    orientation: float
+    cells: np.ndarray
+    nodes: np.ndarray
+    mesh: SurfaceMesh
+    seed: np.ndarray
+    warp_direction: np.ndarray
+    normal: np.ndarray
+    material: Hyperelastic
+    pattern: PatternResult
+    warp: np.ndarray
+    fill: np.ndarray
+    shear_angle: np.ndarray
+    kinematic: PlyDrape | None
+    kinematic_error: str | None
+    kinematic_warp: np.ndarray
+    kinematic_fill: np.ndarray
+    kinematic_shear_angle: np.ndarray
+    seconds: float
+    locking_angle: float = float("nan")
+    darted: DartedPattern | None = None
+
+    @property
+    def is_darted(self) -> bool:
+        """Whether the ply is cut open along darts: asked for, placed, and lowering its largest
+        shear (:func:`darts_used`)."""
+        return darts_used(self.darted)
+
+    @property
+    def blank_mesh(self) -> SurfaceMesh:
+        """The mesh of the blank as cut: the ply's mesh opened along its darts, if any."""
+        return self.darted.slits.mesh if self.is_darted else self.mesh
+
+    @property
+    def blank_pattern(self) -> PatternResult:
+        """The pattern of the blank as cut (of :attr:`blank_mesh`)."""
+        return self.darted.after if self.is_darted else self.pattern
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.pattern.converged and self.blank_pattern.converged)
+
+    def summary(self) -> dict[str, Any]:
+        """The numbers for a summary file."""
+        area = self.mesh.cell_areas()
+        shear = self.shear_angle[self.cells]
+        data: dict[str, Any] = {
+            "label": self.label,
+            "plies": self.plies,
+            "orientation": self.orientation,
+            "seed": self.seed,
+            "warp_direction": self.warp_direction,
+            "cells": len(self.cells),
+            "area": float(area.sum()),
+            "converged": self.converged,
+            "reason": self.pattern.reason,
+            "iterations": self.pattern.iterations,
+            "energy": self.pattern.energy,
+            "warp_deviation": self.pattern.warp_deviation,
+            "seconds": self.seconds,
+            "max_shear": float(np.nanmax(np.abs(shear))),
+            "mean_abs_shear": float(area @ np.abs(shear) / area.sum()),
+        }
+        if self.kinematic is not None:
+            data["kinematic_drape"] = self.kinematic.summary()
+            undarted = self.pattern.fields["shear_angle"]  # the net is not darted
+            data["kinematic_drape"]["against_pattern"] = self.kinematic.comparison(undarted, area)
+        elif self.kinematic_error is not None:
+            data["kinematic_drape"] = {"error": self.kinematic_error}
+        data["locking_angle"] = self.locking_angle
+        data["darts"] = None if self.darted is None else self.darted.summary()
+        return data
