@@ -1,13 +1,17 @@
-"""Worker processes for independent solves (a batch's jobs, a laminate's plies): each worker
-started fresh (``spawn``) with its numerical libraries held to its share of the cores."""
+"""Worker processes for independent solves (a batch's jobs, a laminate's plies, a band's
+samples): each worker started fresh (``spawn``) with its numerical libraries held to its share
+of the cores; :func:`parallel_map` runs one function over many tasks here, on such workers or on
+the workers of a Dask distributed scheduler."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
+from typing import Any
 
-__all__ = ["process_pool"]
+__all__ = ["parallel_map", "process_pool"]
 
 
 def _limit_threads(threads: int) -> None:
@@ -30,3 +34,27 @@ def process_pool(workers: int) -> ProcessPoolExecutor:
         initializer=_limit_threads,
         initargs=(threads,),
     )
+
+
+def parallel_map(
+    function: Callable[[Any], Any],
+    tasks: Sequence[Any],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+) -> tuple[list[Any], int]:
+    """``function`` of every task, in their order, and the number of workers that ran them: the
+    workers of the Dask distributed scheduler at ``scheduler`` (``tcp://host:port``), else
+    ``workers`` local processes (:func:`process_pool`), or this process alone when ``workers``
+    is None or 1. ``function`` and the tasks must pickle to run elsewhere."""
+    if scheduler is not None:
+        from dask.distributed import Client
+
+        with Client(scheduler, timeout="20s") as client:
+            outcomes = client.gather(client.map(function, list(tasks), pure=False))
+            count = len(client.scheduler_info()["workers"])
+        return list(outcomes), count
+    if workers is None or workers <= 1:
+        return [function(task) for task in tasks], 1
+    with process_pool(workers) as pool:
+        return list(pool.map(function, tasks)), workers

@@ -12,15 +12,14 @@ boundary length and the area of every panel's pattern, the length of every seam,
 the delivered fabric behaves like the sample; erecting each sample's own patterns with its own
 fabric would give back the intended prestress by construction and say nothing.
 
-The samples are independent solves: in this process, on ``workers`` local processes
-(:func:`vares.parallel.process_pool`, as a batch runs its jobs), or on the workers of a Dask
-scheduler.
+The samples are independent solves: in this process, on ``workers`` local processes (as a batch
+runs its jobs), or on the workers of a Dask scheduler (:func:`vares.parallel.parallel_map`).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -41,7 +40,7 @@ from ..analysis.scatter import (
 from ..materials.base import MaterialError
 from ..materials.fabric_file import ConstantScatter
 from ..materials.presets import FabricPreset
-from ..parallel import process_pool
+from ..parallel import parallel_map
 from ..structures.matching import StructureResult, solve_structure
 from ..structures.panels import Panel
 
@@ -49,7 +48,6 @@ __all__ = [
     "FabricBand",
     "SampleTask",
     "fabric_band",
-    "map_samples",
     "prestress_figures",
     "solve_sample",
     "structure_figures",
@@ -127,26 +125,6 @@ def solve_sample(task: SampleTask) -> SampleOutcome:
         figures.update(prestress_figures(erected))
         converged, reason = erected.converged, erected.reason
     return SampleOutcome(figures, converged, reason, time.perf_counter() - started)
-
-
-def map_samples(
-    function: Callable[[Any], Any],
-    tasks: Sequence[Any],
-    *,
-    workers: int | None = None,
-    scheduler: str | None = None,
-) -> list[Any]:
-    """``function`` of every task, in order: here (``workers`` None or 1), on ``workers`` local
-    processes, or on the Dask scheduler at ``scheduler`` (``tcp://host:port``)."""
-    if scheduler is not None:
-        from dask.distributed import Client
-
-        with Client(scheduler, timeout="20s") as client:
-            return client.gather(client.map(function, list(tasks), pure=False))
-    if workers is None or workers <= 1:
-        return [function(t) for t in tasks]
-    with process_pool(workers) as pool:
-        return list(pool.map(function, tasks))
 
 
 @dataclass
@@ -270,7 +248,7 @@ def fabric_band(
         SampleTask(panels, sample, thickness, load, settings, patterns, erection) for sample in laws
     ]
     started = time.perf_counter()
-    outcomes = map_samples(solve_sample, tasks, workers=workers, scheduler=scheduler)
+    outcomes, _ = parallel_map(solve_sample, tasks, workers=workers, scheduler=scheduler)
     failed = [(k, o.reason) for k, o in enumerate(outcomes) if not o.converged]
     if failed:
         k, reason = failed[0]

@@ -30,7 +30,7 @@ from ..analysis.drape import drape_ply
 from ..geometry.mesh import SurfaceMesh
 from ..materials.forming import locking_angle
 from ..options import OptionsError
-from ..parallel import process_pool
+from ..parallel import parallel_map
 from ..solver.api import solve
 from .laminate_options import LaminateOptions, PlyOptions
 from .laminate_plies import Ply, darts_used
@@ -94,19 +94,8 @@ def drape_tasks(
 ) -> tuple[list[dict[str, Any]], int]:
     """The outcomes of :func:`drape_task` for ``tasks``, in their order, and the number of
     workers that ran them: the Dask scheduler's at ``scheduler`` (``tcp://host:port``), else
-    ``workers`` local processes (in this process when 1)."""
-    if scheduler is not None:
-        from dask.distributed import Client
-
-        with Client(scheduler, timeout="20s") as client:
-            futures = client.map(drape_task, list(tasks), pure=False)
-            outcomes = client.gather(futures)
-            count = len(client.scheduler_info()["workers"])
-        return list(outcomes), count
-    if workers > 1:
-        with process_pool(workers) as pool:
-            return list(pool.map(drape_task, tasks)), workers
-    return [drape_task(task) for task in tasks], 1
+    ``workers`` local processes (in this process when 1; :func:`vares.parallel.parallel_map`)."""
+    return parallel_map(drape_task, tasks, workers=workers, scheduler=scheduler)
 
 
 def on_mould_cells(
