@@ -34,17 +34,27 @@ def face_neighbours(triangles: np.ndarray) -> np.ndarray:
 def barycentric(points: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Barycentric coordinates ``(..., 3)`` of the projections of ``points`` ``(..., 3)`` onto
     the planes of the triangles ``corners`` ``(..., 3, 3)``, and the signed distances ``(...)``
-    of the points from those planes (along the unit normal of corner order)."""
+    of the points from those planes (along the unit normal of corner order).
+
+    A triangle of zero area (its corners on one line or one point: a kinematic net's cell
+    sheared flat) has no plane and holds no point: its coordinates are −inf and its distance
+    +inf, so that a search for the triangle that holds a point passes over it."""
     a, b, c = corners[..., 0, :], corners[..., 1, :], corners[..., 2, :]
     normal = np.cross(b - a, c - a)
     twice_area = np.linalg.norm(normal, axis=-1)
+    has_plane = twice_area > 0
+    twice_area = np.where(has_plane, twice_area, 1.0)  # its normal is 0: no division by 0
     unit = normal / twice_area[..., None]
     rel = points - a
     height = np.einsum("...i,...i->...", rel, unit)
     foot = points - height[..., None] * unit
     l1 = np.einsum("...i,...i->...", np.cross(c - b, foot - b), unit) / twice_area
     l2 = np.einsum("...i,...i->...", np.cross(a - c, foot - c), unit) / twice_area
-    return np.stack([l1, l2, 1.0 - l1 - l2], axis=-1), height
+    coordinates = np.stack([l1, l2, 1.0 - l1 - l2], axis=-1)
+    return (
+        np.where(has_plane[..., None], coordinates, -np.inf),
+        np.where(has_plane, height, np.inf),
+    )
 
 
 class FaceLocator:
