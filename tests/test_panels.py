@@ -220,7 +220,10 @@ def test_panels_command_from_cell_data_3dm_and_files(tmp_path):
 def test_the_iteration_limit_holds_for_every_panel_solve_and_the_matching(tmp_path):
     import json
 
-    result = run("panels", "--example", "hypar-strips", "-o", tmp_path, "--max-iterations", 2, "-q")
+    # from the projection, whose panels need more than the limit (from the automatic start, one
+    # ARAP step further, they need 2)
+    limited = ("--max-iterations", 2, "--initial-guess", "projection")
+    result = run("panels", "--example", "hypar-strips", "-o", tmp_path, *limited, "-q")
     assert result.exit_code == 0, result.stderr
     data = json.loads((tmp_path / "structure.json").read_text())
     assert data["converged"] and 1 <= data["coupled_iterations"] <= 2
@@ -230,7 +233,11 @@ def test_the_iteration_limit_holds_for_every_panel_solve_and_the_matching(tmp_pa
         assert summary["options"]["max_iterations"] == 2
         assert summary["converged"] and all(s["iterations"] <= 2 for s in summary["steps"])
     # with the default limit the same panels take 3 iterations in their first step
-    structure = solve_structure(split_panels(*hypar_strips()), vares.materials.NeoHooke(1e3, 0.3))
+    structure = solve_structure(
+        split_panels(*hypar_strips()),
+        vares.materials.NeoHooke(1e3, 0.3),
+        initial_guess="projection",
+    )
     assert max(r.steps[0].iterations for r in structure.results) == 3
 
 
@@ -281,7 +288,10 @@ def test_ten_strips_with_seams_through_cells_match_quadratically(prestressed):
     material = FABRIC if prestressed else vares.materials.NeoHooke(1e3, 0.3)
     structure = solve_structure(panels, material, seams=seams, **settings)
     assert structure.converged, structure.reason
-    assert structure.iterations <= 5
+    # the seams match to round-off within 5 iterations; the Lagrangian's gradient may then sit
+    # at its round-off floor, which two more full steps that do not halve it show
+    matched = next(h.iteration for h in structure.history if h.violation <= h.round_off)
+    assert matched <= 5 and structure.iterations <= max(5, matched + 2)
     assert max(r.max_segment_mismatch_after for r in structure.seam_reports) < 1e-9
     assert max(r.mismatch_before for r in structure.seam_reports) > 1e-5
     violations = [h.violation for h in structure.history]

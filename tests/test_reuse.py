@@ -112,12 +112,16 @@ def test_a_solver_that_never_reuses_factorises_every_system():
 
 def test_inexact_newton_finds_the_same_pattern_with_one_factorisation():
     """SuperLU reuses its first factorisation: the same optimum as exact Newton (every tangent
-    factorised) to round-off, in as many Newton iterations, ending superlinearly."""
+    factorised) to round-off, in as many Newton iterations, ending superlinearly. From the
+    projection (the automatic start, one ARAP step further, is two iterations from the optimum
+    here: too few to show the rate)."""
     mesh = examples.hypar(size=10.0, rise=0.06, n=40)
-    inexact = vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu")
+    inexact = vares.solve(
+        mesh, NEO_HOOKE, linear_solver="scipy-superlu", initial_guess="projection"
+    )
     exact_solver = linear.SuperLUSolver()
     exact_solver.reuse_iterations = 0
-    reference = _solve_with(mesh, exact_solver)
+    reference = _solve_with(mesh, exact_solver, initial_guess="projection")
     assert inexact.converged and reference.converged
     assert reference.factorisations == reference.iterations and reference.cg_iterations == 0
     assert inexact.factorisations == 1 and inexact.cg_iterations >= inexact.iterations - 1
@@ -131,12 +135,12 @@ def test_inexact_newton_finds_the_same_pattern_with_one_factorisation():
     assert residuals[-1] < 1e-2 * residuals[-2]  # superlinear at the end, not linear
 
 
-def _solve_with(mesh, solver):
+def _solve_with(mesh, solver, **settings):
     """A solve whose context gets ``solver`` (an instance) instead of a new one by name."""
     original = linear._SOLVERS["scipy-superlu"]
     linear._SOLVERS["scipy-superlu"] = lambda: solver
     try:
-        return vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu")
+        return vares.solve(mesh, NEO_HOOKE, linear_solver="scipy-superlu", **settings)
     finally:
         linear._SOLVERS["scipy-superlu"] = original
 

@@ -136,7 +136,9 @@ def _load_kernels(mesh: SurfaceMesh, material: Hyperelastic, solver: str | None)
 def _solve(mesh, material, thickness, prestress, options, callback, given) -> PatternResult:
     started = time.perf_counter()
     run = _Run(mesh, material, thickness, prestress, options, callback)
-    start = initial_guess(mesh, options, given)
+    # an energy blind to the pattern's rotation: the automatic start is taken one ARAP step on
+    isotropic = not material.needs_fibres and prestress is None
+    start = initial_guess(mesh, options, given, isotropic=isotropic)
     attempt = run.attempt(start)
     may_restart = options.initial_guess == "auto" and options.strategy != "pseudo-time"
     if attempt.overlap is not None and may_restart and start.kind != "tutte":

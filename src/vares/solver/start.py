@@ -32,7 +32,7 @@ from ..geometry.flatten import (
 from ..geometry.mesh import SurfaceMesh
 from ..mechanics.rigid import rigid_modes
 from ..options import OptionsError
-from .linear import LinearSolver, get_solver
+from .linear import IndefiniteMatrixError, LinearSolver, get_solver
 from .options import SolveOptions
 
 __all__ = ["ARAP_STEPS", "PROJECTION_MIN_AREA_RATIO", "Start", "arap_refined", "initial_guess"]
@@ -156,7 +156,10 @@ def _factorizer(solver: LinearSolver):
     """A function from a symmetric positive definite matrix to its solver ``rhs ↦ x``."""
 
     def factorize(matrix):
-        solver.factorize(matrix.tocsr(), definite=True)
+        try:
+            solver.factorize(matrix.tocsr(), definite=True)
+        except IndefiniteMatrixError:  # round-off made a definite-only back end refuse it
+            solver.factorize(matrix.tocsr())
         return solver.solve
 
     return factorize
