@@ -1,5 +1,7 @@
 """The cut line of a pattern: its seam line grown outwards by an allowance that may differ from
-edge to edge (a seam, a hemmed free edge, a cable pocket, a clamp edge)."""
+edge to edge (a seam, a hemmed free edge, a cable pocket, a clamp edge), or by one allowance
+round its outline and holes (:func:`cut_outline`: a DXF's cut line, a ply's extended boundary);
+the signed area of a ring (:func:`ring_area`)."""
 
 from __future__ import annotations
 
@@ -7,10 +9,36 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["MITRE_LIMIT", "allowance_outline"]
+__all__ = ["MITRE_LIMIT", "allowance_outline", "cut_outline", "ring_area"]
 
 #: Corners whose mitre would reach further than this many allowances are bevelled.
 MITRE_LIMIT = 4.0
+
+
+def ring_area(ring: np.ndarray) -> float:
+    """The signed area of a closed ring ``(k, 2)`` (positive counter-clockwise; the shoelace
+    formula)."""
+    x, y = ring[:, 0], ring[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def cut_outline(rings: Sequence[np.ndarray], allowance: float) -> list[np.ndarray]:
+    """The region inside ``rings`` ``(k, 2)`` (the largest the outline, the others its holes)
+    grown by ``allowance`` ≥ 0 with mitred corners (at most :data:`MITRE_LIMIT` allowances
+    out): its rings ``(k, 2)``, not closed, the outline first and counter-clockwise, then what
+    is left of the holes, clockwise. Of a region in several pieces the largest is kept."""
+    from shapely.geometry import Polygon
+    from shapely.geometry.polygon import orient
+
+    outer = max(range(len(rings)), key=lambda k: abs(ring_area(rings[k])))
+    polygon = Polygon(rings[outer], [r for k, r in enumerate(rings) if k != outer])
+    if allowance > 0:
+        polygon = polygon.buffer(allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
+    if polygon.geom_type != "Polygon":
+        polygon = max(polygon.geoms, key=lambda g: g.area)
+    polygon = orient(polygon, 1.0)
+    outline = [np.asarray(polygon.exterior.coords)[:-1]]
+    return outline + [np.asarray(r.coords)[:-1] for r in polygon.interiors]
 
 
 def allowance_outline(ring: np.ndarray, allowances: Sequence[float] | np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.outline import cut_outline
 from ..units import unit_factor
 from .files import atomic_path
 
@@ -57,31 +58,6 @@ class CutPiece:
     marks: np.ndarray | None = field(default=None, repr=False)
     cut: np.ndarray | None = field(default=None, repr=False)
     darts: Sequence[np.ndarray] = field(default=(), repr=False)
-
-
-def _signed_area(ring: np.ndarray) -> float:
-    x, y = ring[:, 0], ring[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-
-
-def cut_outline(seam_rings: list[np.ndarray], allowance: float) -> list[np.ndarray]:
-    """The cut line: the region inside the seam rings grown by ``allowance`` (mitred corners).
-
-    The largest ring is the outline, the others are holes. Returns closed rings ``(k, 2)``.
-    """
-    from shapely.geometry import Polygon
-
-    outer = max(seam_rings, key=lambda r: abs(_signed_area(r)))
-    holes = [r for r in seam_rings if r is not outer]
-    polygon = Polygon(outer, holes)
-    if allowance > 0:
-        polygon = polygon.buffer(allowance, join_style="mitre", mitre_limit=4.0)
-    geoms = getattr(polygon, "geoms", [polygon])
-    rings = []
-    for geom in geoms:
-        rings.append(np.asarray(geom.exterior.coords)[:-1])
-        rings.extend(np.asarray(interior.coords)[:-1] for interior in geom.interiors)
-    return rings
 
 
 def _marks_along(ring: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:

@@ -2,8 +2,9 @@
 ply's seed, areas and masses, and every ply nested on the roll (DESIGN.md §8).
 
 A ply's **net boundary** is its pattern's boundary (the part's edge, flat); its **extended
-boundary** is the net grown by ``trim_allowance`` (mesh units, mitred corners): the blank as cut,
-with the excess trimmed after draping. The **rosette** sits at the pattern point of the mould node
+boundary** is the net grown by ``trim_allowance`` (mesh units, mitred corners; the DXF's cut line,
+:func:`vares.geometry.outline.cut_outline`): the blank as cut, with the excess trimmed after
+draping. The **rosette** sits at the pattern point of the mould node
 nearest the ply's seed, with the warp (0°) and the fill (90°) of the ply's pattern. Every pattern
 comes with its warp along +x, which is the roll's direction: the plies are nested as they are
 (or turned by 180°, which keeps the warp along the roll) by
@@ -22,20 +23,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.outline import MITRE_LIMIT, ring_area
+from ..geometry.outline import cut_outline as extended_boundary
 from ..units import METRES
 from .laminate import LaminateResult
 from .nesting import RollNest, nest_pieces, usable_width
 
 __all__ = ["MITRE_LIMIT", "PlyBlank", "extended_boundary", "nest_plies", "ply_blanks", "ring_area"]
-
-#: Longest mitre of the extended boundary's corners, in allowances (shapely's ``mitre_limit``).
-MITRE_LIMIT = 4.0
-
-
-def ring_area(ring: np.ndarray) -> float:
-    """The signed area of a closed ring ``(k, 2)`` (positive counter-clockwise)."""
-    x, y = ring[:, 0], ring[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
 
 
 @dataclass(frozen=True)
@@ -79,28 +73,6 @@ class PlyBlank:
     def width(self) -> float:
         """The extended blank's width across the warp (along y)."""
         return float(np.ptp(self.trim[0][:, 1]))
-
-
-def _rings(polygon) -> list[np.ndarray]:
-    from shapely.geometry.polygon import orient
-
-    polygon = orient(polygon, 1.0)  # the outline counter-clockwise, holes clockwise
-    rings = [np.asarray(polygon.exterior.coords)[:-1]]
-    return rings + [np.asarray(r.coords)[:-1] for r in polygon.interiors]
-
-
-def extended_boundary(net: Sequence[np.ndarray], allowance: float) -> list[np.ndarray]:
-    """The net rings (outline first, then holes) grown by ``allowance`` ≥ 0 with mitred corners
-    (at most :data:`MITRE_LIMIT` allowances out): the outline first, then what is left of the
-    holes."""
-    from shapely.geometry import Polygon
-
-    polygon = Polygon(net[0], list(net[1:]))
-    if allowance > 0:
-        polygon = polygon.buffer(allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
-    if polygon.geom_type != "Polygon":  # holes never split a grown polygon; keep the largest
-        polygon = max(polygon.geoms, key=lambda g: g.area)
-    return _rings(polygon)
 
 
 def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
