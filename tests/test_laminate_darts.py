@@ -269,8 +269,19 @@ def test_cli_refuses_bad_darts_and_both_workers_and_scheduler(tmp_path):
     write_surface(tmp_path / "mould.obj", mould())
     (tmp_path / "job.toml").write_text(JOB + '\n[[ply]]\nname = "A"\n', encoding="utf-8")
     result = run("laminate", tmp_path / "job.toml", "--darts", "yes")
-    assert result.exit_code == 2 and "--darts must be 'auto' or 'none'" in result.stderr
+    assert result.exit_code == 2 and "'yes' is not one of 'none', 'auto'" in result.stderr
     result = run("laminate", tmp_path / "job.toml", "--workers", 1, "--scheduler", "tcp://h:1")
+    assert result.exit_code == 2 and "not both" in result.stderr
+    # the flags are the [laminate] table's options: their bounds, the flag named
+    result = run("laminate", tmp_path / "job.toml", "--workers", 0)
+    assert result.exit_code == 2 and "--workers must be > 0; got 0" in result.stderr
+    # and the job's table with a scheduler takes no --workers beside it
+    (tmp_path / "job.toml").write_text(
+        JOB.replace("[laminate]", '[laminate]\nscheduler = "tcp://h:1"')
+        + '\n[[ply]]\nname = "A"\n',
+        encoding="utf-8",
+    )
+    result = run("laminate", tmp_path / "job.toml", "--workers", 2)
     assert result.exit_code == 2 and "not both" in result.stderr
     assert not (tmp_path / "out").exists()
 

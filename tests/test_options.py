@@ -172,3 +172,36 @@ def test_command_line_values_are_checked_by_the_same_declarations(tmp_path):
     result = run("example", "hypar", "-o", tmp_path, "--damping", 0)
     assert result.exit_code == 2 and "--damping must be > 0" in result.stderr
     assert not any(tmp_path.iterdir())
+
+
+def test_an_option_reused_in_another_table_keeps_its_declaration():
+    """A laminate's and a ply's darts and locking angle are those of a single ply's drape
+    (vares.options.reused): the same kind, choices and bounds, in their own tables, refused
+    alike; a default of None makes the ply's "not given"."""
+    from vares.analysis.dart_options import DartOptions
+    from vares.analysis.drape_options import DrapeOptions
+    from vares.structures.laminate_options import LaminateOptions, PlyOptions
+
+    for cls, section in ((LaminateOptions, "laminate"), (PlyOptions, "ply")):
+        for original, name in ((DartOptions, "darts"), (DrapeOptions, "locking_angle")):
+            spec, source = cls.specs()[name], original.specs()[name]
+            assert (spec.kind, spec.choices, spec.positive) == (
+                source.kind,
+                source.choices,
+                source.positive,
+            )
+            assert spec.section == section and spec.help != source.help
+    assert LaminateOptions.defaults()["darts"] == DartOptions.defaults()["darts"] == "none"
+    assert PlyOptions.defaults()["darts"] is None and PlyOptions.specs()["darts"].optional
+    assert PlyOptions.specs()["dart_lines"].help.startswith("Dart lines of the ply's own")
+    for make in (
+        lambda: DartOptions(darts="sometimes"),
+        lambda: LaminateOptions(darts="sometimes"),
+        lambda: PlyOptions(name="A", darts="sometimes"),
+    ):
+        with pytest.raises(OptionsError, match="darts must be one of none, auto; got 'sometimes'"):
+            make()
+    with pytest.raises(OptionsError, match="locking_angle must be > 0"):
+        LaminateOptions(locking_angle=0.0)
+    assert LaminateOptions(darts="AUTO").darts == "auto"
+    assert LaminateOptions().to_dict(section="laminate")["darts"] == "none"

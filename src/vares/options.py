@@ -11,6 +11,10 @@ declarations:
   table holds (``vares.app.job``); an unknown key is refused with the closest valid spelling;
 - the command line: ``vares.app.cli`` makes one flag per field from the same spec.
 
+An option that means the same in another table (a laminate's darts, those of ``vares drape``) is
+declared once and taken over there with :func:`reused`: its kind, choices and bounds stay the
+original's; the other table may say in its help what it does with it.
+
 Values are checked and normalised when an options object is made (sequences become tuples, ints
 become floats where a float is meant), so every entry point accepts and refuses the same values.
 """
@@ -21,7 +25,7 @@ import difflib
 import inspect
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields, replace
 from os import PathLike
 from typing import Any, ClassVar, Self
 
@@ -30,6 +34,7 @@ __all__ = [
     "OptionsError",
     "Spec",
     "option",
+    "reused",
     "split_settings",
     "suggest",
     "takes_options",
@@ -230,6 +235,27 @@ def option(
         positive,
         default is None if optional is None else optional,
         None if flags is None else tuple(flags),
+    )
+    return field(default=default, metadata={"option": spec})
+
+
+def reused(
+    cls: type[Options],
+    name: str,
+    *,
+    section: str,
+    default: Any = MISSING,
+    help: str | None = None,
+) -> Any:
+    """The option ``name`` of ``cls`` as a field of another options class, in the job-file
+    table ``section``: the same kind, choices, bounds and flags, the same help unless ``help``
+    says more (what the other table does with it), the same default unless ``default`` is given
+    (``None`` makes it optional: "not given here")."""
+    spec = cls.specs()[name]
+    if default is MISSING:
+        default = cls.defaults()[name]
+    spec = replace(
+        spec, section=section, help=help or spec.help, optional=spec.optional or default is None
     )
     return field(default=default, metadata={"option": spec})
 

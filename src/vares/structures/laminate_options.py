@@ -1,13 +1,19 @@
 """The options of a laminate and of each of its plies, declared once (see :mod:`vares.options`):
 the ``[laminate]`` table and the ``[[ply]]`` tables of a laminate job, and the keywords of
-:func:`vares.structures.laminate.drape_laminate` and :class:`vares.structures.laminate.Ply`."""
+:func:`vares.structures.laminate.drape_laminate` and :class:`vares.structures.laminate.Ply`.
+The darts and the locking angle are those of a single ply's drape
+(:class:`~vares.analysis.dart_options.DartOptions`,
+:class:`~vares.analysis.drape_options.DrapeOptions`), taken over with
+:func:`vares.options.reused`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..analysis.dart_options import DartOptions
+from ..analysis.drape_options import DrapeOptions
 from ..materials.forming import FABRIC_KINDS
-from ..options import Options, OptionsError, option
+from ..options import Options, OptionsError, option, reused
 
 __all__ = ["LaminateOptions", "PlyOptions"]
 
@@ -87,21 +93,19 @@ class LaminateOptions(Options):
         "tasks on its workers instead of local processes.",
         section="laminate",
     )
-    darts: str = option(
-        "none",
-        "str",
-        "Darts in every ply that names none: 'auto' places them where a ply's shear reaches its "
-        "locking angle and solves the ply again with them open (docs/composites.md, Darts).",
+    darts: str = reused(
+        DartOptions,
+        "darts",
         section="laminate",
-        choices=("none", "auto"),
+        help="Darts in every ply that names none: 'auto' places them where a ply's shear reaches "
+        "its locking angle and solves the ply again with them open (docs/composites.md, Darts).",
     )
-    locking_angle: float | None = option(
-        None,
-        "float",
-        "Locking angle in degrees, at most 90, of every ply that names none (default: the "
-        "fabric kind's): producibility and darts.",
+    locking_angle: float | None = reused(
+        DrapeOptions,
+        "locking_angle",
         section="laminate",
-        positive=True,
+        help="Locking angle in degrees, at most 90, of every ply that names none (default: the "
+        "fabric kind's): producibility and darts.",
     )
 
     areal_weight: float | None = option(
@@ -232,27 +236,26 @@ class PlyOptions(Options):
         positive=True,
     )
 
-    darts: str | None = option(
-        None,
-        "str",
-        "Darts in this ply: 'auto' or 'none' (default: the laminate's).",
+    darts: str | None = reused(
+        DartOptions,
+        "darts",
         section="ply",
-        choices=("none", "auto"),
+        default=None,
+        help="Darts in this ply: 'auto' or 'none' (default: the laminate's).",
     )
-    dart_lines: str | None = option(
-        None,
-        "path",
-        "Dart lines of the ply's own: a curves file (points 'x y z', a blank line between two "
+    dart_lines: str | None = reused(
+        DartOptions,
+        "dart_lines",
+        section="ply",
+        help="Dart lines of the ply's own: a curves file (points 'x y z', a blank line between two "
         "lines, or a 3dm file), each from the ply's boundary into it; opened as they are.",
-        section="ply",
     )
-    locking_angle: float | None = option(
-        None,
-        "float",
-        "Locking angle of the ply in degrees, at most 90 (default: the laminate's, else its "
-        "fabric kind's).",
+    locking_angle: float | None = reused(
+        DrapeOptions,
+        "locking_angle",
         section="ply",
-        positive=True,
+        help="Locking angle of the ply in degrees, at most 90 (default: the laminate's, else its "
+        "fabric kind's).",
     )
 
     def check(self) -> None:

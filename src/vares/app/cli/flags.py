@@ -55,6 +55,7 @@ PANELS = {
     "cut": "Cutting and nesting",
     "drape": "Drape and producibility",
     "scatter": "Fabric scatter",
+    "laminate": "Laminate",
 }
 #: Kinds given on the command line as one comma-separated string.
 _TEXT_KINDS = {"vector", "plane", "floats", "strings", "paths"}

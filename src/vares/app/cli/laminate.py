@@ -1,49 +1,38 @@
 """``vares laminate``: drape every ply of a laminate job and check every pair of plies."""
 
+from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
+from ...structures.laminate_options import LaminateOptions
 from .common import console, guarded
-from .flags import InputError
+from .flags import build, flags, with_flags
 
 __all__ = ["laminate"]
 
 
+#: The options of the job's ``[laminate]`` table that the command line may replace.
+REPLACED = ("workers", "scheduler", "darts")
+
+
+@with_flags(
+    flags(
+        LaminateOptions,
+        exclude=[name for name in LaminateOptions.specs() if name not in REPLACED],
+        defaults=dict.fromkeys(REPLACED),
+    )
+)
 def laminate(
     job_file: Annotated[Path, typer.Argument(metavar="JOB", help="Laminate job file (TOML).")],
     output: Annotated[
         Path | None,
         typer.Option("--output", "-o", help="Write the outputs here instead of the job's folder."),
     ] = None,
-    workers: Annotated[
-        int | None,
-        typer.Option(
-            "--workers",
-            min=1,
-            help="Processes that drape the plies at once (default: the workers of the job's "
-            "laminate table, else one per core for a mould of 4000 cells or more).",
-        ),
-    ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            "--scheduler",
-            help="Drape the plies as tasks on the Dask distributed scheduler at this address "
-            "(tcp://host:port) instead of local processes.",
-        ),
-    ] = None,
-    darts: Annotated[
-        str | None,
-        typer.Option(
-            "--darts",
-            help="'auto': darts in every ply that names none, where its shear reaches its "
-            "locking angle; 'none': no darts (default: the job's laminate table).",
-        ),
-    ] = None,
     force: Annotated[bool, typer.Option("--force", "-f", help="Overwrite output files.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Show no progress.")] = False,
+    **values: Any,
 ) -> None:
     """Drape every ply of a laminate (mechanical pattern and kinematic net) and check every pair.
 
@@ -51,19 +40,18 @@ def laminate(
     fill per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply),
     orientations.csv, patterns/drape_ANGLEdeg.vtu, plybook.html (the ply book), plies/PLY.dxf
     (each ply's cutter file, its darts on layer DART) and, with a roll_width, nest.dxf (every
-    ply nested on the roll) into the output directory. Exit status 1 when a ply did not
-    converge.
+    ply nested on the roll) into the output directory. --workers, --scheduler and --darts
+    replace the values of the job's laminate table. Exit status 1 when a ply did not converge.
     """
 
     def body() -> None:
-        if darts is not None and darts not in ("none", "auto"):
-            raise InputError(f"--darts must be 'auto' or 'none'; got {darts!r}")
-        if workers is not None and scheduler is not None:
-            raise InputError("give --workers or --scheduler, not both")
         from ..laminate_job import load_laminate_job
         from ..laminate_outputs import laminate_files, run_laminate_job
 
         job = load_laminate_job(job_file)
+        given = {name for name in REPLACED if values.get(name) is not None}
+        kept = {n: getattr(job.laminate, n) for n in LaminateOptions.specs() if n not in given}
+        job = replace(job, laminate=build(LaminateOptions, values, **kept))
         if output is not None:
             job = job.with_output(output)
 
@@ -82,14 +70,7 @@ def laminate(
                     f"{drape.pattern.iterations} iterations, {drape.seconds:.2f} s{dart_text}"
                 )
 
-        run = run_laminate_job(
-            job,
-            force=force,
-            workers=workers,
-            scheduler=scheduler,
-            darts=darts,
-            callback=progress,
-        )
+        run = run_laminate_job(job, force=force, callback=progress)
         result = run.result
         if not quiet:
             _show(result)
