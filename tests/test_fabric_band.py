@@ -17,8 +17,8 @@ from vares.geometry.examples import STRUCTURE_EXAMPLES
 from vares.materials import MaterialError
 from vares.materials.biaxial_model import ECRModel, compensation_protocol, simulate
 from vares.materials.compensation_law import strains_per_cycle
-from vares.materials.fabric_file import ConstantScatter, constant_scatter
-from vares.materials.presets import file_fabric
+from vares.materials.fabric_file import ConstantScatter
+from vares.materials.presets import file_fabric, load_presets
 from vares.structures.matching import solve_structure
 from vares.structures.panels import split_panels
 
@@ -100,14 +100,16 @@ def test_erected_prestress_of_the_nominal_case_is_the_plain_erection(strips, bat
 def test_a_band_needs_measured_compensation_values(strips, batch):
     with pytest.raises(MaterialError, match="no measured compensation values"):
         fabric_band(strips, replace(batch, compensation=None), prestress=(2.0, 1.5), **SETTINGS)
-    with pytest.raises(MaterialError, match="no scatter of its constants given"):
-        fabric_band(strips, batch, scatter=ScatterOptions(sampled="constants"), **SETTINGS)
+    with pytest.raises(MaterialError, match="has no scatter of its constants"):
+        constants = ScatterOptions(sampled="constants")
+        fabric_band(strips, replace(batch, scatter=None), scatter=constants, **SETTINGS)
 
 
 def test_band_of_the_fitted_constants(strips, batch):
     """Sampling E1, E2, nu12: the nominal case is the fitted law's pattern and its plain
-    erection; zero scatter gives zero spread exactly; the file's scatter gives a band."""
-    scatter = constant_scatter(SHIPPED / "pes-batch-42.toml")
+    erection; zero scatter gives zero spread exactly; the file's scatter (read with the
+    fabric, and taken by default) gives a band."""
+    scatter = batch.scatter
     assert (scatter.E1, scatter.E2, scatter.specimens) == pytest.approx(
         (14.9603, 15.4456, 2), rel=1e-5
     )
@@ -121,25 +123,35 @@ def test_band_of_the_fitted_constants(strips, batch):
     plain = prestress_figures(vares.erect(structure))
     for name, value in plain.items():
         assert zero.band.nominal[name] == pytest.approx(value, rel=1e-12), name
-    band = fabric_band(strips, batch, constants=scatter, scatter=options, **SETTINGS)
+    band = fabric_band(strips, batch, scatter=options, **SETTINGS)
     assert band.band.nominal == zero.band.nominal
     assert all(band.band.spread(n) > 0 for n in band.band.names)
     assert [set(s) for s in band.cases] == [{"E1", "E2", "nu12"}] * 3
     assert band.to_dict()["constants_std"]["E1"] == scatter.E1
 
 
-def test_constant_scatter_errors(tmp_path):
+def test_the_scatter_table_is_read_with_the_fabric(tmp_path):
+    """A fabric file's [NAME.scatter] is read, and checked, once with its fabric."""
     path = tmp_path / "f.toml"
-    path.write_text('[f]\nE1 = 1\n[f.scatter]\nE1 = "x"\n', encoding="utf-8")
-    with pytest.raises(MaterialError, match=r"\[f.scatter\]: E1, E2 and nu12 must be numbers"):
-        constant_scatter(path)
-    path.write_text("[f]\nE1 = 1\n[f.scatter]\nE1 = -1.0\n", encoding="utf-8")
-    with pytest.raises(MaterialError, match="must be numbers ≥ 0"):
-        constant_scatter(path)
-    with pytest.raises(MaterialError, match="has no fabric"):
-        constant_scatter(path, "g")
-    path.write_text("[f]\nE1 = 1\n", encoding="utf-8")
-    assert constant_scatter(path) is None
+    head = '[f]\nE1 = 600.0\nE2 = 450.0\nG12 = 20.0\nnu12 = 0.3\nsource = "test"\n'
+    path.write_text(head + "[f.scatter]\nE1 = 2.0\nnu12 = 0.01\nspecimens = 3\n", encoding="utf-8")
+    assert file_fabric(path).scatter == ConstantScatter(2.0, 0.0, 0.01, 3)
+    path.write_text(head + '[f.scatter]\nE1 = "x"\n', encoding="utf-8")
+    with pytest.raises(
+        MaterialError, match=r"f.toml: \[f.scatter\]: E1, E2 and nu12 must be numbers"
+    ):
+        file_fabric(path)
+    path.write_text(head + "[f.scatter]\nE1 = -1.0\n", encoding="utf-8")
+    with pytest.raises(MaterialError, match=r"\[f.scatter\]: E1, E2 and nu12 must be numbers ≥ 0"):
+        load_presets(path)
+    path.write_text(head + "[f.scatter]\nspecimens = 0\n", encoding="utf-8")
+    with pytest.raises(MaterialError, match="specimens must be a positive integer"):
+        file_fabric(path)
+    path.write_text(head + "scatter = 1.0\n", encoding="utf-8")
+    with pytest.raises(MaterialError, match="scatter must be a table"):
+        file_fabric(path)
+    path.write_text(head, encoding="utf-8")
+    assert file_fabric(path).scatter is None
 
 
 def test_strains_per_cycle():

@@ -28,7 +28,8 @@ def write_obj(path, mesh):
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     """A small sail, three hypar strips as three files, a small saddle; the shipped fabric file
-    with its compensation values' scatter set to 0, and one of one specimen."""
+    with its compensation values' scatter set to 0, one of one specimen, and one with the
+    scatter of its constants set to 0."""
     root = tmp_path_factory.mktemp("band")
     text = SHIPPED.read_text(encoding="utf-8")
     zero = re.sub(r"^(warp_std|fill_std) = .*$", r"\1 = 0.0", text, flags=re.M)
@@ -37,6 +38,11 @@ def files(tmp_path_factory):
     assert one != zero
     (root / "zero.toml").write_text(zero, encoding="utf-8")
     (root / "one.toml").write_text(one, encoding="utf-8")
+    head, table = text.split("[pes-batch-42.scatter]")
+    table = re.sub(r"^(E1|E2|nu12) = .*$", r"\1 = 0.0", table, count=3, flags=re.M)
+    (root / "zero-constants.toml").write_text(
+        head + "[pes-batch-42.scatter]" + table, encoding="utf-8"
+    )
     mesh, ids = STRUCTURE_EXAMPLES["hypar-strips"](strips=3, n=12)
     strips = [write_obj(root / f"{p.name}.obj", p.mesh) for p in split_panels(mesh, ids)]
     return {
@@ -107,18 +113,36 @@ def test_a_pattern_run_writes_the_band_of_its_own_pattern(files, tmp_path):
     assert rerun["figures"] == figures and rerun["samples"] == band["samples"]
 
 
-def test_zero_scatter_gives_the_run_a_band_of_zero_width(files, tmp_path):
-    out = tmp_path / "zero"
-    result = run(*pattern_args(files, files["root"] / "zero.toml", out, "--scatter",
-                               "--scatter-samples", 2))  # fmt: skip
-    assert result.exit_code == 0, result.stderr
-    summary = json.loads((out / "summary.json").read_text())
-    figures, own = summary["scatter"]["figures"], own_dimensions(out)
-    for name in DIMENSIONS:
-        assert figures[name]["nominal"] == pytest.approx(own[name], abs=1e-9), name
-    for name, d in figures.items():
-        assert d["spread"] == 0.0 and d["min"] == d["max"] == d["nominal"], name
-    assert any("scatter of the compensation values" in w for w in summary["warnings"])
+@pytest.mark.parametrize(
+    ("name", "sampled", "what", "extra"),
+    [
+        ("zero.toml", "compensation", "compensation values (warp_std and fill_std", ()),
+        (
+            "zero-constants.toml",
+            "constants",
+            "constants (E1, E2 and nu12",
+            ("--compensate-by", "law"),
+        ),
+    ],
+)
+def test_zero_scatter_is_refused_by_a_run_as_by_fabric_band(
+    files, tmp_path, name, sampled, what, extra
+):
+    """Standard deviations written as 0 (of two specimens) give no band: every sample would be
+    the nominal pattern. A patterning run and 'vares fabric band' refuse the file alike, with
+    one message, before any solve."""
+    path, out = files["root"] / name, tmp_path / "run"
+    args = pattern_args(files, path, out, "--scatter", "--scatter-sampled", sampled, *extra)
+    refused = run(*args)
+    assert refused.exit_code == 2, refused.stderr
+    band = run("fabric", "band", files["sail"], "--fabric", path, "--sampled", sampled, "-o",
+               tmp_path / "band")  # fmt: skip
+    assert band.exit_code == 2, band.stderr
+    message = error_line(band).removeprefix("vares: error: ")
+    assert message.startswith(f"fabric 'pes-batch-42' has no scatter of its {what} are 0")
+    assert "its band would be the nominal pattern alone" in message
+    assert error_line(refused).endswith(f"{path}: {message}")
+    assert not out.exists() and not (tmp_path / "band").exists()
 
 
 def test_the_fitted_constants_sampled_in_a_run_compensated_by_the_law(files, tmp_path):

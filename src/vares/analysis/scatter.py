@@ -211,22 +211,34 @@ def _aligned(reference: np.ndarray, moving: np.ndarray) -> np.ndarray:
     return (moving - b) @ (u @ np.diag([1.0, d]) @ vt) + a
 
 
-def check_scatter(fabric: FabricPreset) -> None:
-    """Raise :class:`MaterialError` for a fabric without measured compensation values or
-    without their scatter (both standard deviations 0, as from a single specimen): its band
-    would be the mean pattern alone."""
-    c = fabric.compensation
-    if c is None:
-        raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
-    if c.warp_std == 0 and c.fill_std == 0:
-        origin = (
-            "warp_std and fill_std are 0 or not given"
-            if c.specimens is None or c.specimens > 1
-            else f"the values of {c.specimens} specimen"
-        )
+def check_scatter(fabric: FabricPreset, sampled: str = "compensation") -> None:
+    """Raise :class:`MaterialError` for a fabric whose band of what is ``sampled`` (one of
+    :data:`SAMPLED`) would be the nominal pattern alone: without measured compensation values
+    or without the scatter of its constants (a ``[scatter]`` table), or with a scatter that is
+    unknown (the values of one specimen) or 0 (every standard deviation 0 or not given). One
+    message for every command that samples them."""
+    if sampled not in SAMPLED:
+        raise ValueError(f"sampled must be one of {', '.join(SAMPLED)}; got {sampled!r}")
+    if sampled == "constants":
+        s = fabric.scatter
+        if s is None:
+            raise MaterialError(
+                f"fabric {fabric.name!r} has no scatter of its constants (no [scatter] table): "
+                "fit two or more stiffness records"
+            )
+        what, records, specimens = "constants", "stiffness", s.specimens
+        deviations, zero = (s.E1, s.E2, s.nu12), "E1, E2 and nu12 are 0 or not given"
+    else:
+        c = fabric.compensation
+        if c is None:
+            raise MaterialError(f"fabric {fabric.name!r} has no measured compensation values")
+        what, records, specimens = "compensation values", "compensation", c.specimens
+        deviations, zero = (c.warp_std, c.fill_std), "warp_std and fill_std are 0 or not given"
+    if specimens == 1 or not any(deviations):
+        origin = "the values of one specimen: unknown" if specimens == 1 else zero
         raise MaterialError(
-            f"fabric {fabric.name!r} has no scatter of its compensation values ({origin}): "
-            "its band would be the mean pattern alone; fit two or more compensation records"
+            f"fabric {fabric.name!r} has no scatter of its {what} ({origin}): its band would be "
+            f"the nominal pattern alone; fit two or more {records} records"
         )
 
 

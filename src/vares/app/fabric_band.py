@@ -205,11 +205,12 @@ def fabric_band(
     """The nominal case and ``scatter.samples`` sampled cases of ``panels`` (module docs).
 
     ``prestress`` defaults to the one the values were measured at; ``constants``: the scatter
-    of the constants (:func:`vares.materials.fabric_file.constant_scatter`), needed when they
-    are sampled; ``settings`` are options of :func:`vares.solve_structure` (``warp_direction``,
+    of the constants when they are sampled (default: the fabric's, its file's ``[scatter]``);
+    ``settings`` are options of :func:`vares.solve_structure` (``warp_direction``,
     ``match_seams``, …); ``erected`` False leaves out the erections. Raises
     :class:`MaterialError` for a fabric without what is to be sampled and when a case does not
-    converge.
+    converge. A scatter of 0 gives a band of zero width (the commands refuse it:
+    :func:`vares.analysis.scatter.check_scatter`).
     """
     scatter = scatter or ScatterOptions()
     c = fabric.compensation
@@ -217,8 +218,9 @@ def fabric_band(
         raise MaterialError(f"fabric {fabric.name!r} has no measured prestress: give one")
     load = tuple(float(v) for v in (c.prestress if prestress is None else prestress))
     if scatter.sampled == "constants":
+        constants = fabric.scatter if constants is None else constants
         if constants is None:
-            raise MaterialError(f"fabric {fabric.name!r}: no scatter of its constants given")
+            raise MaterialError(f"fabric {fabric.name!r} has no scatter of its constants")
         law = constants_law(fabric, fabric.E1, fabric.E2, fabric.nu12)
         drawn = constant_samples(fabric, constants, scatter.samples, scatter.seed)
         cases = [{"E1": a, "E2": b, "nu12": n} for a, b, n in drawn]

@@ -3,15 +3,15 @@ of a job, ``--scatter`` on ``vares pattern``, ``example``, ``panels`` and ``cut`
 
 :func:`check_run_band` refuses, before the solve, a job whose band could not be the band of its
 own patterns: no fabric file, a file without the scatter of what is sampled (or with that of
-one specimen: unknown), a run compensated
-otherwise than the samples are, a prestress that is not one uniform value, patterns optimised
-for the erected state. :func:`run_band` then patterns the run's panels (one surface, a
-structure's panels, or a cut job's strips, each with the warp it was solved with) by
-:func:`vares.app.fabric_band.fabric_band` with the job's solver, structure and erection options:
-the nominal case again, and every sample. The samples are solved in this process (a job holds no
-worker settings; ``vares batch`` runs whole jobs in parallel). The nominal case is the run's own
-pattern solved again with the same law, prestress and options; ``nominal_difference`` records
-how far its figures are from the run's (0 to round-off).
+one specimen: unknown, or of 0: :func:`vares.analysis.scatter.check_scatter`, as ``vares fabric
+band`` refuses it), a run compensated otherwise than the samples are, a prestress that is not
+one uniform value, patterns optimised for the erected state. :func:`run_band` then patterns the
+run's panels (one surface, a structure's panels, or a cut job's strips, each with the warp it
+was solved with) by :func:`vares.app.fabric_band.fabric_band` with the job's solver, structure
+and erection options: the nominal case again, and every sample. The samples are solved in this
+process (a job holds no worker settings; ``vares batch`` runs whole jobs in parallel). The
+nominal case is the run's own pattern solved again with the same law, prestress and options;
+``nominal_difference`` records how far its figures are from the run's (0 to round-off).
 """
 
 from __future__ import annotations
@@ -21,9 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..analysis.scatter import pattern_dimensions
+from ..analysis.scatter import check_scatter, pattern_dimensions
 from ..materials.base import MaterialError
-from ..materials.fabric_file import ConstantScatter, constant_scatter
 from ..materials.presets import FabricPreset, fabric, file_fabric
 from ..solver.options import SolveOptions
 from ..structures.panels import Panel
@@ -40,15 +39,12 @@ ASKED = "--scatter ([scatter])"
 
 @dataclass(frozen=True)
 class BandInputs:
-    """What a run's band is computed from: the fabric file, its fabric, the constants' scatter
-    (sampling the constants), the run's uniform prestress (warp, fill[, shear]) and what the
-    run is to be warned of (a scatter of 0)."""
+    """What a run's band is computed from: the fabric file, its fabric (with the scatter of what
+    is sampled) and the run's uniform prestress (warp, fill[, shear])."""
 
     path: Path
     fabric: FabricPreset
-    constants: ConstantScatter | None
     prestress: tuple[float, ...]
-    notes: tuple[str, ...] = ()
 
 
 def check_run_band(job: Job) -> BandInputs | None:
@@ -70,46 +66,21 @@ def check_run_band(job: Job) -> BandInputs | None:
     except MaterialError as exc:
         raise JobError(f"{ASKED}: {exc}") from None
     by = material.compensate_by or preset.compensate_by
-    constants = None
-    if options.sampled == "compensation":
-        if by != "measured":
-            raise JobError(
-                f"{ASKED}: {path}: the run compensates by the fitted law: sample its "
-                "constants, add --scatter-sampled constants ([scatter] sampled = 'constants')"
-            )
-        c = preset.compensation
-        if c is None:
-            raise JobError(
-                f"{ASKED} needs a fabric file with scatter: {path}: fabric {preset.name!r} has "
-                "no measured compensation values"
-            )
-        scatter = (c.specimens, c.warp_std, c.fill_std)
-    else:
-        if by != "law":
-            raise JobError(
-                f"{ASKED}: {path}: sampling the constants is the band of a pattern compensated "
-                "by the fitted law; the run compensates by the measured values: add "
-                "--compensate-by law, or sample the compensation values"
-            )
-        constants = constant_scatter(path, preset.name)
-        if constants is None:
-            raise JobError(
-                f"{ASKED} needs a fabric file with scatter: {path}: fabric {preset.name!r} has "
-                "no scatter of its constants (no [scatter] table)"
-            )
-        scatter = (constants.specimens, constants.E1, constants.E2, constants.nu12)
-    what = "compensation values" if constants is None else "constants"
-    if scatter[0] == 1:
+    if options.sampled == "compensation" and by != "measured":
         raise JobError(
-            f"{ASKED} needs a fabric file with scatter: {path}: its {what} come from one "
-            "specimen, their scatter is unknown (written as 0); fit two or more records"
+            f"{ASKED}: {path}: the run compensates by the fitted law: sample its "
+            "constants, add --scatter-sampled constants ([scatter] sampled = 'constants')"
         )
-    notes = ()
-    if not any(scatter[1:]):
-        notes = (
-            f"the scatter of the {what} in {path} is 0: every sample is the nominal pattern "
-            "and every spread is 0",
+    if options.sampled == "constants" and by != "law":
+        raise JobError(
+            f"{ASKED}: {path}: sampling the constants is the band of a pattern compensated "
+            "by the fitted law; the run compensates by the measured values: add "
+            "--compensate-by law, or sample the compensation values"
         )
+    try:
+        check_scatter(preset, options.sampled)
+    except MaterialError as exc:
+        raise JobError(f"{ASKED} needs a fabric file with scatter: {path}: {exc}") from None
     prestress = job.prestress
     if prestress.field is not None or prestress.warp is None:
         measured = preset.compensation
@@ -128,14 +99,13 @@ def check_run_band(job: Job) -> BandInputs | None:
             "patterns optimised for the erected state: leave one of them out"
         )
     load = tuple(float(v) for v in prestress.value({}))
-    return BandInputs(path, preset, constants, load, notes)
+    return BandInputs(path, preset, load)
 
 
 def run_band(outcome: JobOutcome, inputs: BandInputs, options: SolveOptions) -> RunBand:
     """The band of a run's patterns (module docs); a case that does not converge gives a band
     with its ``reason`` instead (and a warning in the outcome)."""
     job = outcome.job
-    outcome.warnings.extend(inputs.notes)
     settings: dict[str, Any] = {"options": options}
     structure = outcome.structure
     if structure is None:
@@ -156,7 +126,6 @@ def run_band(outcome: JobOutcome, inputs: BandInputs, options: SolveOptions) -> 
                 job.material.thickness,
                 inputs.prestress,
                 scatter=job.scatter,
-                constants=inputs.constants,
                 erection=job.erection,
                 **settings,
             )

@@ -29,19 +29,18 @@ numbers were found. ``vares fabric fit`` writes one; it is usable wherever a pre
     [[pes-batch-42.specimens]]      # one table per specimen
     …
 
-Only ``E1, E2, G12, nu12, source`` and the compensation table's ``prestress``, ``warp`` and
-``fill`` are read into the preset; :func:`constant_scatter` reads the scatter table (for the
-band of the constants, :mod:`vares.app.fabric_band`); the rest documents the fit.
+Only ``E1, E2, G12, nu12, source``, the compensation table's ``prestress``, ``warp`` and
+``fill`` (and their scatter) and the scatter table's ``E1, E2, nu12`` and ``specimens``
+(:func:`read_scatter`: for the band of the constants, :mod:`vares.app.fabric_band`) are read
+into the preset; the rest documents the fit.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -55,9 +54,9 @@ __all__ = [
     "COMPENSATE_BY",
     "ConstantScatter",
     "MeasuredCompensation",
-    "constant_scatter",
     "fabric_toml",
     "fit_toml",
+    "read_scatter",
     "read_test_tables",
     "toml_string",
 ]
@@ -94,24 +93,14 @@ class ConstantScatter:
     specimens: int | None = None
 
 
-def constant_scatter(path: str | Path, name: str | None = None) -> ConstantScatter | None:
-    """The ``[NAME.scatter]`` table of a fabric file (``name``: the fabric, default the file's
-    only one); None when the entry has none. Raises :class:`MaterialError` for a file that is
-    not valid TOML, an unknown name, or values that are not non-negative numbers."""
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise MaterialError(f"{path}: not valid TOML: {exc}") from exc
-    if name is None:
-        if len(data) != 1:
-            raise MaterialError(f"{path} holds {len(data)} fabrics: name one")
-        name = next(iter(data))
-    if name not in data or not isinstance(data[name], dict):
-        raise MaterialError(f"{path} has no fabric [{name}]")
-    table = data[name].get("scatter")
+def read_scatter(entry: Mapping[str, Any], where: str) -> ConstantScatter | None:
+    """The ``scatter`` table of a preset file's entry (``where``: ``"FILE: [name]"`` for
+    messages), None when it has none; raises :class:`MaterialError` for values that are not
+    non-negative numbers."""
+    table = entry.get("scatter")
     if table is None:
         return None
-    where = f"{path}: [{name}.scatter]"
+    where = f"{where[:-1]}.scatter]"
     if not isinstance(table, dict):
         raise MaterialError(f"{where} must be a table")
     try:

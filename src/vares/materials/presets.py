@@ -27,7 +27,14 @@ from pathlib import Path
 
 from .anisotropic import OrthotropicStVenantKirchhoff
 from .base import MaterialError
-from .fabric_file import COMPENSATE_BY, EXTRA_KEYS, MeasuredCompensation, read_test_tables
+from .fabric_file import (
+    COMPENSATE_BY,
+    EXTRA_KEYS,
+    ConstantScatter,
+    MeasuredCompensation,
+    read_scatter,
+    read_test_tables,
+)
 
 __all__ = ["FabricPreset", "fabric", "file_fabric", "load_presets", "presets"]
 
@@ -38,8 +45,9 @@ _FIELDS = {"E1", "E2", "G12", "nu12"}
 class FabricPreset:
     """A named orthotropic fabric (stiffnesses as force per length, use thickness 1).
 
-    A fabric from biaxial tests also has its measured ``compensation`` values and the way a
-    pattern is compensated by default (``compensate_by``: ``"measured"`` or ``"law"``).
+    A fabric from biaxial tests also has its measured ``compensation`` values, the way a
+    pattern is compensated by default (``compensate_by``: ``"measured"`` or ``"law"``) and the
+    ``scatter`` of its fitted constants over the specimens (its ``[NAME.scatter]`` table).
     """
 
     name: str
@@ -51,6 +59,7 @@ class FabricPreset:
     source: str
     compensation: MeasuredCompensation | None = None
     compensate_by: str = "law"
+    scatter: ConstantScatter | None = None
 
     def material(self, compensate_by: str | None = None) -> OrthotropicStVenantKirchhoff:
         """The fabric's law; with ``compensate_by="measured"`` (default: the preset's choice)
@@ -105,6 +114,7 @@ def _parse(text: str, origin: str) -> dict[str, FabricPreset]:
             source=str(entry["source"]),
             compensation=compensation,
             compensate_by=choice or ("measured" if compensation else "law"),
+            scatter=read_scatter(entry, f"{origin}: [{name}]"),
             **values,
         )
         try:

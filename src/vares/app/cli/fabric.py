@@ -319,8 +319,6 @@ def band(
         from ...analysis.scatter import ScatterOptions, check_scatter
         from ...geometry.examples import STRUCTURE_EXAMPLES
         from ...io.files import check_writable, write_text
-        from ...materials.base import MaterialError
-        from ...materials.fabric_file import constant_scatter
         from ...materials.presets import file_fabric
         from ...options import OptionsError
         from ...structures.options import StructureOptions
@@ -355,20 +353,14 @@ def band(
         if warp_direction is not None:
             settings["warp_direction"] = _vector(warp_direction, "--warp-direction")
         preset = file_fabric(fabric_file)
-        constants = None
+        check_scatter(preset, scatter.sampled)
         if scatter.sampled == "constants":
-            constants = constant_scatter(fabric_file, preset.name)
-            if constants is None or constants.E1 == constants.E2 == constants.nu12 == 0:
-                raise MaterialError(
-                    f"fabric {preset.name!r} has no scatter of its constants (no [scatter] "
-                    "table, or its E1, E2, nu12 are 0): fit two or more stiffness records"
-                )
+            s = preset.scatter
             title = (
-                f"{preset.name}: E1 {preset.E1:.1f} ± {constants.E1:.1f}, E2 {preset.E2:.1f} ± "
-                f"{constants.E2:.1f} kN/m, nu12 {preset.nu12:.3f} ± {constants.nu12:.3f}"
+                f"{preset.name}: E1 {preset.E1:.1f} ± {s.E1:.1f}, E2 {preset.E2:.1f} ± "
+                f"{s.E2:.1f} kN/m, nu12 {preset.nu12:.3f} ± {s.nu12:.3f}"
             )
         else:
-            check_scatter(preset)
             c = preset.compensation
             title = (
                 f"{preset.name}: warp {100 * c.warp:.3f} ± {100 * c.warp_std:.3f} %, fill "
@@ -388,7 +380,6 @@ def band(
             preset,
             prestress=_pair(prestress, "--prestress"),
             scatter=scatter,
-            constants=constants,
             erected=erect,
             workers=workers,
             scheduler=scheduler,
