@@ -14,11 +14,14 @@ solver's secant iteration.
     python benchmarks/locking.py --rings 20 30 40 60 --stabilisation 10   # mesh convergence
 
     python benchmarks/locking.py --yarn-strain paired --ratios 1e6 --stabilisation 10 \
-        --continuation 1e2 1e4                                       # E/G 1e6 through 1e2, 1e4
+        --continuation 1e2 1e3 1e4 1e5 --both      # E/G 1e6 through decades, with and without
+                                                    # the extrapolation of the stages' patterns
 
 (``--stabilisation c``: the share ``c G12/E`` of the yarn part kept per cell;
 ``--continuation``: the ratios solved first, each stage from the last pattern, ``--align-up-to``:
-the warp aligned at the stages up to this ratio and the rotation held above it; docs/locking.md.)
+the warp aligned at the stages up to this ratio and the rotation held above it; from the third
+stage on each starts from the extrapolation in 1/ratio of the two before, unless
+``--no-extrapolation``; docs/locking.md.)
 The blank's extent along the warp, the fill and the two diagonals is compared with the net's
 pattern on the same mesh.
 """
@@ -61,6 +64,7 @@ def run(
     start: np.ndarray,
     continuation: tuple[float, ...] = (),
     align_up_to: float | None = None,
+    extrapolate: bool = True,
 ) -> dict:
     """One solve from the net's pattern, through the ratios of ``continuation`` below
     ``ratio``."""
@@ -75,6 +79,7 @@ def run(
         initial_guess=start,
         continuation=tuple(r for r in continuation if r < ratio),
         align_up_to=align_up_to,
+        extrapolate=extrapolate,
     )
     shear = cell_shear_angle(mesh, result.coordinates, material, result.fibres)
     table = meridian_shear(mesh, shear, polar_angles=POLAR)
@@ -94,6 +99,29 @@ def run(
         "extent": extent,
         "extent_error": extent - net_extent,
     }
+
+
+def report(rings: int, ratio: float, label: str, r: dict) -> None:
+    """Print one solve's meridians, spread, errors and extent."""
+    print(
+        f"\n{rings} rings ({r['cells']} cells), E/G = {ratio:.0e}, {label}: "
+        f"converged {r['converged']}, {r['iterations']} iterations, "
+        f"{r['stage_seconds']} = {r['seconds']:.1f} s"
+    )
+    print("polar angle         " + "  ".join(f"{p:6.0f}" for p in POLAR))
+    for azimuth, line in zip((45, 135, 225, 315), r["table"], strict=True):
+        print(f"  meridian {azimuth:3d}°     " + "  ".join(f"{v:6.2f}" for v in line))
+    print("  spread of the 4   " + "  ".join(f"{v:6.2f}" for v in r["spread"]))
+    print("  mean of the 4     " + "  ".join(f"{v:6.2f}" for v in r["mean"]))
+    print("  max |Δ net|       " + "  ".join(f"{v:6.2f}" for v in r["error"]))
+    print("  max |Δ mesh net|  " + "  ".join(f"{v:6.2f}" for v in r["mesh_error"]))
+    print(
+        "  extent warp / fill / +45 / -45 [mm]  "
+        + " / ".join(f"{v:.2f}" for v in r["extent"])
+        + "  (minus the net's: "
+        + " / ".join(f"{v:+.2f}" for v in r["extent_error"])
+        + ")"
+    )
 
 
 def main() -> None:
@@ -120,6 +148,16 @@ def main() -> None:
         default=None,
         help="align the warp at the stages up to this E/G, hold the rotation above it",
     )
+    parser.add_argument(
+        "--no-extrapolation",
+        action="store_true",
+        help="start every stage from the last pattern (not the extrapolation of the two before)",
+    )
+    parser.add_argument(
+        "--both",
+        action="store_true",
+        help="with --continuation: solve with and without the extrapolation, side by side",
+    )
     args = parser.parse_args()
     print("net (exact sphere)  " + "  ".join(f"{v:6.2f}" for v in NET))
     rows = []
@@ -133,37 +171,25 @@ def main() -> None:
         extent = blank_extent(start, Fibres.from_angles(0.0))
         print("  extent warp / fill / +45 / -45 [mm]  " + " / ".join(f"{v:.2f}" for v in extent))
         for ratio in args.ratios:
+            variants = [True, False] if args.both else [not args.no_extrapolation]
             for yarn_strain in args.yarn_strain:
-                r = run(
-                    rings,
-                    ratio,
-                    yarn_strain,
-                    args.stabilisation,
-                    net,
-                    start,
-                    tuple(args.continuation),
-                    args.align_up_to,
-                )
-                rows.append((rings, ratio, yarn_strain, r))
-                print(
-                    f"\n{rings} rings ({r['cells']} cells), E/G = {ratio:.0e}, {yarn_strain}: "
-                    f"converged {r['converged']}, {r['iterations']} iterations, "
-                    f"{r['stage_seconds']} = {r['seconds']:.1f} s"
-                )
-                print("polar angle         " + "  ".join(f"{p:6.0f}" for p in POLAR))
-                for azimuth, line in zip((45, 135, 225, 315), r["table"], strict=True):
-                    print(f"  meridian {azimuth:3d}°     " + "  ".join(f"{v:6.2f}" for v in line))
-                print("  spread of the 4   " + "  ".join(f"{v:6.2f}" for v in r["spread"]))
-                print("  mean of the 4     " + "  ".join(f"{v:6.2f}" for v in r["mean"]))
-                print("  max |Δ net|       " + "  ".join(f"{v:6.2f}" for v in r["error"]))
-                print("  max |Δ mesh net|  " + "  ".join(f"{v:6.2f}" for v in r["mesh_error"]))
-                print(
-                    "  extent warp / fill / +45 / -45 [mm]  "
-                    + " / ".join(f"{v:.2f}" for v in r["extent"])
-                    + "  (minus the net's: "
-                    + " / ".join(f"{v:+.2f}" for v in r["extent_error"])
-                    + ")"
-                )
+                for extrapolate in variants if args.continuation else [True]:
+                    label = yarn_strain
+                    if args.continuation:
+                        label += ", extrapolated" if extrapolate else ", from the last"
+                    r = run(
+                        rings,
+                        ratio,
+                        yarn_strain,
+                        args.stabilisation,
+                        net,
+                        start,
+                        tuple(args.continuation),
+                        args.align_up_to,
+                        extrapolate,
+                    )
+                    rows.append((rings, ratio, label, r))
+                    report(rings, ratio, label, r)
     print(
         "\n| rings | cells | E/G | yarn strain | iterations | s | spread (30/45/60/75°) | "
         "max abs. error vs net | vs the mesh's net | extent − net's [mm] |"

@@ -394,17 +394,17 @@ def test_continuation_reaches_yarn_to_shear_1e6_from_the_default_start_without_l
     assert (locked.max(axis=0) - locked.min(axis=0)).max() > 9.0
 
 
-def test_continuation_converges_where_the_direct_stiff_solve_does_not():
+def test_continuation_takes_a_fraction_of_the_iterations_of_the_direct_stiff_solve():
     """A cap of 600 cells at E/G = 1e6, pairs of nodes, warp aligned, the default start: solved
-    directly the warp alignment does not converge (877 iterations measured); through 1e2 and
-    1e4 it does, in 64 (13 + 36 + 15; the last stage from the extrapolation of the two)."""
+    directly it takes hundreds of iterations (measured 449, converged; 877 and not converged
+    on 2026-12-02's main); through the decades 1e2 … 1e5 45 (13 + 16 + 8 + 5 + 3), through 1e2
+    and 1e4 64 (13 + 36 + 15; the last stage from the extrapolation of the two)."""
     mesh = irregular_cap(100.0, 90.0, 10, 0.3, 1)
     stiff = OrthotropicStVenantKirchhoff(E1=1e6, E2=1e6, G12=1.0, nu12=0.0)
     settings = {"yarn_strain": "paired", "yarn_stabilisation": 1e-5, "warp_direction": (1, 0, 0)}
-    staged = solve_yarn_strain(mesh, stiff, continuation=(1e2, 1e4), **settings)
-    assert staged.converged and staged.iterations < 120
+    staged = solve_yarn_strain(mesh, stiff, continuation=DECADES, **settings)
+    assert staged.converged and staged.iterations < 60
     direct = solve_yarn_strain(mesh, stiff, **settings)
-    assert not direct.converged
     assert direct.iterations > 4 * staged.iterations
 
 

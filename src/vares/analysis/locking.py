@@ -68,6 +68,7 @@ def solve_yarn_strain(
     options: SolveOptions | None = None,
     continuation: Sequence[float] = (),
     align_up_to: float | None = None,
+    extrapolate: bool = True,
 ) -> SmoothedSolve:
     """The cutting pattern of ``mesh`` with the yarn strains treated as ``yarn_strain`` says
     (``"element"`` is the formulation :func:`vares.solve` uses) and ``yarn_stabilisation`` the
@@ -89,8 +90,8 @@ def solve_yarn_strain(
     ``yarn_stabilisation × E`` of the law (its share ``yarn_stabilisation × E/E_stage``, at most
     0.5). With ``warp_direction`` the warp is aligned at the stages of ratio up to
     ``align_up_to`` (default: every stage); the later ones hold the rotation and yarn angle of
-    the last aligned pattern. The iterations and seconds returned are the stages' sums; each
-    stage is in ``stages``.
+    the last aligned pattern; ``extrapolate`` false starts every stage from the last pattern.
+    The iterations and seconds returned are the stages' sums; each stage is in ``stages``.
     """
     settings = {"yarn_strain": yarn_strain, "yarn_stabilisation": yarn_stabilisation}
     if warp_direction is not None:
@@ -104,7 +105,13 @@ def solve_yarn_strain(
 
     if chosen.yarn_continuation:
         result, stages = solve_in_stages(
-            solve_one, mesh, material, chosen, initial_guess, align_up_to=align_up_to
+            solve_one,
+            mesh,
+            material,
+            chosen,
+            initial_guess,
+            align_up_to=align_up_to,
+            extrapolate=extrapolate,
         )
     else:
         result = solve_one(material, chosen, initial_guess)

@@ -81,6 +81,7 @@ def solve_in_stages(
     initial_guess: np.ndarray | None = None,
     *,
     align_up_to: float | None = None,
+    extrapolate: bool = True,
 ) -> tuple[PatternResult, list[ContinuationStage]]:
     """The pattern of ``material`` through the ratios ``options.yarn_continuation``.
 
@@ -90,7 +91,8 @@ def solve_in_stages(
     the law's per-cell yarn stiffness ``yarn_stabilisation × E`` (its share ``yarn_stabilisation
     × E / E_stage``, at most :data:`MAX_STAGE_SHARE`). With a warp direction the warp is aligned
     at the stages of ratio up to ``align_up_to`` (default: every stage); the later ones hold the
-    yarn angle of the last (the pattern comes back with the warp along +x).
+    yarn angle of the last (the pattern comes back with the warp along +x). ``extrapolate``
+    false: every stage from the last pattern (the comparison of docs/locking.md).
 
     Returns the law's result, its ``history``, ``steps`` and ``strategy`` those of every stage
     (each record's strategy led by :func:`stage_label`) before its own, ``elapsed`` their sum
@@ -115,7 +117,9 @@ def solve_in_stages(
         stage_options = base.replace(yarn_stabilisation=share)
         if direction is not None and not aligned:
             stage_options = stage_options.replace(warp_direction=None, warp_angle=held_angle)
-        start, extrapolated = _extrapolated(mesh, solved, 1.0 / stage_ratio, guess)
+        start, extrapolated = _extrapolated(
+            mesh, solved if extrapolate else [], 1.0 / stage_ratio, guess
+        )
         result = solve_one(law, stage_options, start)
         stages.append(
             ContinuationStage(
