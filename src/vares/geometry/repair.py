@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 
+from .._jit import njit
 from .elements import ELEMENTS
 from .mesh import EdgeTable, MeshError, corner_fans, index_listing
 from .weld import coincident_nodes

@@ -19,7 +19,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+
+from .._jit import compiled, njit
 
 __all__ = ["CellImage", "View", "rasterise", "triangles_of"]
 
@@ -136,10 +137,75 @@ def rasterise(
     triangles, owners = triangles_of(cells)
     pixel_coordinates = (coordinates - low) / h
     z = np.zeros(len(coordinates)) if depth is None else np.asarray(depth, dtype=float)
-    _fill(pixel_coordinates[:, 0].copy(), pixel_coordinates[:, 1].copy(), z, triangles, owners,
-          index, buffer)  # fmt: skip
+    fill = _fill if depth is not None or compiled(len(triangles)) else _fill_spans
+    fill(pixel_coordinates[:, 0].copy(), pixel_coordinates[:, 1].copy(), z, triangles, owners,
+         index, buffer)  # fmt: skip
     extent = (float(low[0]), float(low[0] + columns * h), float(low[1]), float(low[1] + rows * h))
     return CellImage(index, extent, buffer)
+
+
+def _fill_spans(
+    px: np.ndarray,
+    py: np.ndarray,
+    pz: np.ndarray,
+    triangles: np.ndarray,
+    owners: np.ndarray,
+    index: np.ndarray,
+    depth: np.ndarray,
+) -> None:
+    """:func:`_fill` for cells seen flat (``pz`` zero: the first triangle over a pixel takes
+    it) as array arithmetic, for small meshes: each triangle's run of pixel centres along each
+    row, from where its edges cross the row; the pixels at either end of a run are tested as
+    :func:`_fill` tests every pixel (the same weights), those between lie inside."""
+    rows, columns = index.shape
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    xa, ya, xb, yb, xc, yc = px[a], py[a], px[b], py[b], px[c], py[c]
+    area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
+    with np.errstate(invalid="ignore"):
+        i0 = np.maximum(np.ceil(np.minimum(np.minimum(xa, xb), xc) - 0.5), 0)
+        i1 = np.minimum(np.floor(np.maximum(np.maximum(xa, xb), xc) - 0.5), columns - 1)
+        j0 = np.maximum(np.ceil(np.minimum(np.minimum(ya, yb), yc) - 0.5), 0)
+        j1 = np.minimum(np.floor(np.maximum(np.maximum(ya, yb), yc) - 0.5), rows - 1)
+        usable = (area != 0.0) & np.isfinite(i0 + i1 + j0 + j1) & (i1 >= i0)
+    height = np.where(usable, np.maximum(j1 - j0 + 1, 0), 0).astype(np.int64)
+    t = np.repeat(np.arange(len(triangles)), height)  # one (triangle, row) a run
+    y = j0[t] + (np.arange(t.size) - np.repeat(np.cumsum(height) - height, height)) + 0.5
+    sign = np.sign(area[t])
+    low, high = i0[t] - 0.5, i1[t] + 0.5
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # w(x) · area = p + q x for each of the three weights (DESIGN: barycentric, as _fill)
+        for (x1, y1), (x2, y2) in (
+            ((xb, yb), (xc, yc)),
+            ((xc, yc), (xa, ya)),
+            ((xa, ya), (xb, yb)),
+        ):
+            p = x1[t] * (y2[t] - y) - x2[t] * (y1[t] - y)
+            q = (y1 - y2)[t] * sign
+            p = p * sign
+            crossing = -p / q
+            low = np.where(q > 0, np.maximum(low, crossing), low)
+            high = np.where(q < 0, np.minimum(high, crossing), high)
+            high = np.where((q == 0) & (p < 0), -np.inf, high)
+    start = np.maximum(np.ceil(low - 0.5) - 1, i0[t])
+    stop = np.minimum(np.floor(high - 0.5) + 1, i1[t])
+    length = np.where(stop >= start, stop - start + 1, 0).astype(np.int64)
+    t, y, start = np.repeat(t, length), np.repeat(y, length), np.repeat(start, length)
+    offset = np.arange(t.size) - np.repeat(np.cumsum(length) - length, length)
+    i = start + offset
+    end = (offset < 2) | (np.repeat(length, length) - offset <= 2)  # the ends: tested
+    e, x, ye = t[end], i[end] + 0.5, y[end]
+    xa, ya, xb, yb, xc, yc, area = xa[e], ya[e], xb[e], yb[e], xc[e], yc[e], area[e]
+    wa = ((xb - x) * (yc - ye) - (xc - x) * (yb - ye)) / area
+    wb = ((xc - x) * (ya - ye) - (xa - x) * (yc - ye)) / area
+    wc = 1.0 - wa - wb
+    keep = np.ones(t.size, dtype=bool)
+    keep[end] = (wa >= -1e-12) & (wb >= -1e-12) & (wc >= -1e-12)
+    pixel = (y[keep] - 0.5).astype(np.int64) * columns + i[keep].astype(np.int64)
+    t = t[keep]
+    free = depth.reshape(-1)[pixel] > 0.0  # z = 0 is nearer than what the pixel holds
+    pixel, t = pixel[free][::-1], t[free][::-1]  # the last write of a pixel is its first triangle
+    depth.reshape(-1)[pixel] = 0.0
+    index.reshape(-1)[pixel] = owners[t]
 
 
 @njit(cache=True)

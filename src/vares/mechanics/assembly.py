@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 
+from .._jit import compiled, njit
 from ..geometry.mesh import SurfaceMesh
 
 __all__ = ["Assembler", "Connectivity"]
@@ -59,8 +59,10 @@ class Assembler:
         degree = np.diff(node_ptr)
         node_row = np.repeat(np.arange(n), degree)
         within = np.arange(node_col.size) - node_ptr[node_row]  # rank of b in row a
+        small = not compiled(sum(len(c) for c in mesh.cells.values()))
+        entries_of = _sorted_entries if small else _node_entries
         node_entry = np.concatenate(
-            [_node_entries(cells, node_ptr, node_col) for cells in mesh.cells.values()]
+            [entries_of(cells, node_ptr, node_col) for cells in mesh.cells.values()]
         )
 
         i = np.arange(d)[:, None]
@@ -98,7 +100,8 @@ class Assembler:
             m, nen = cells.shape
             entries = node_entry[entry_start : entry_start + m * nen * nen]
             entry_start += m * nen * nen
-            _element_positions(
+            positions = _positions if small else _element_positions
+            positions(
                 entries,
                 nen,
                 d,
@@ -123,9 +126,14 @@ class Assembler:
         """Global Hessian over the free dofs (CSR) from per-cell ``(m, nen, d, nen, d)`` blocks."""
         data = np.zeros(self.nnz + 1)
         start = 0
+        small = not compiled(sum(len(h) for h in hessians))
         for h in hessians:  # scatter-add block by block, without a concatenated copy
             values = h.reshape(-1)
-            _scatter_add(data, self._position[start : start + values.size], values)
+            position = self._position[start : start + values.size]
+            if small:
+                np.add.at(data, position, values)  # in order too: the same sums
+            else:
+                _scatter_add(data, position, values)
             start += values.size
         return sp.csr_matrix(
             (data[:-1], self._indices, self._indptr),
@@ -144,6 +152,35 @@ def _node_pattern(mesh: SurfaceMesh | Connectivity) -> tuple[np.ndarray, np.ndar
     )
     pattern.sum_duplicates()  # sorted, unique columns in every row
     return pattern.indptr.astype(np.int64), pattern.indices.astype(np.int64)
+
+
+def _sorted_entries(cells: np.ndarray, node_ptr: np.ndarray, node_col: np.ndarray) -> np.ndarray:
+    """:func:`_node_entries` by a sorted search (numpy, for small meshes): the pattern's
+    entries in order are its pairs ``(row, column)`` in lexicographic order."""
+    n = len(node_ptr) - 1
+    keys = np.repeat(np.arange(n), np.diff(node_ptr)) * n + node_col
+    pairs = cells[:, :, None] * n + cells[:, None, :]  # (m, a, b)
+    return np.searchsorted(keys, pairs.reshape(-1)).astype(np.int64)
+
+
+def _positions(
+    entries: np.ndarray,
+    nen: int,
+    d: int,
+    node_row: np.ndarray,
+    node_ptr: np.ndarray,
+    degree: np.ndarray,
+    within: np.ndarray,
+    target: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """:func:`_element_positions` as array arithmetic (numpy, for small meshes)."""
+    entry = entries.reshape(-1, nen, 1, nen, 1)  # (m, a, i, b, j)
+    row = node_row[entry]
+    i = np.arange(d).reshape(1, 1, d, 1, 1)
+    j = np.arange(d).reshape(1, 1, 1, 1, d)
+    base = d * d * node_ptr[row] + d * i * degree[row] + d * within[entry]
+    out[:] = target[base + j].reshape(-1)
 
 
 @njit(cache=True)

@@ -21,8 +21,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from ..geometry.elements import ReferenceElement, determinant, inverse
 from .kernels import BlockResult, project_psd
 

@@ -23,8 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from .._jit import compiled, lanes, njit
 from ..geometry.elements import ReferenceElement, determinant, inverse
 from ..materials import Fibres, Hyperelastic
 
@@ -85,11 +85,16 @@ def block_energy(
     The caller ensures ``det J > 0`` (see :meth:`vares.problem.Problem.inverted_cells`).
     """
     dtype = np.result_type(pattern_nodes, metric)
-    det_j, K, C = _kinematics(
-        np.ascontiguousarray(pattern_nodes, dtype=dtype),
-        np.ascontiguousarray(element.shape_gradients, dtype=dtype),
-        np.ascontiguousarray(metric, dtype=dtype),
-    )
+    m, nq = len(pattern_nodes), len(element.quadrature_weights)
+    nodes = np.ascontiguousarray(pattern_nodes, dtype=dtype)
+    shape_gradients = np.ascontiguousarray(element.shape_gradients, dtype=dtype)
+    metric = np.ascontiguousarray(metric, dtype=dtype)
+    det_j, K, C = np.empty((m, nq), dtype), np.empty((m, nq, 2, 2), dtype), np.empty_like(metric)
+    if compiled(m):
+        _kinematics(nodes, shape_gradients, metric, det_j, K, C)
+    else:
+        outputs = map(lanes, (det_j, K, C))
+        _kinematics.py_func(lanes(nodes), shape_gradients, lanes(metric), *outputs)
     response = material.response(C, fibres, tangent=order >= 2)
     psi, S = response.psi, response.stress
     if prestress is not None:
@@ -100,21 +105,25 @@ def block_energy(
     energy = (det_j * psi) @ scale
     if order == 0:
         return BlockResult(energy, None, None)
-    tangent = response.tangent if order >= 2 else np.zeros((1, 1, 2, 2, 2, 2), dtype)
-    gradient, jacobian_hessian = _derivatives(
-        det_j,
-        K,
-        C,
-        np.ascontiguousarray(np.broadcast_to(psi, det_j.shape), dtype=dtype),
-        np.ascontiguousarray(np.broadcast_to(S, C.shape), dtype=dtype),
-        np.ascontiguousarray(tangent, dtype=dtype),
-        np.ascontiguousarray(element.shape_gradients, dtype=dtype),
-        scale,
-        order >= 2,
-    )
+    with_hessian = order >= 2
+    tangent = response.tangent if with_hessian else np.zeros((1, 1, 2, 2, 2, 2), dtype)
+    psi = np.ascontiguousarray(np.broadcast_to(psi, det_j.shape), dtype=dtype)
+    S = np.ascontiguousarray(np.broadcast_to(S, C.shape), dtype=dtype)
+    tangent = np.ascontiguousarray(tangent, dtype=dtype)
+    gradient = np.zeros((m, shape_gradients.shape[1], 2), dtype)
+    jacobian_hessian = np.zeros((m, nq, 4, 4) if with_hessian else (1, 1, 4, 4), dtype)
+    if compiled(m):
+        _derivatives(
+            det_j, K, C, psi, S, tangent, shape_gradients, scale, with_hessian, gradient,
+            jacobian_hessian,
+        )  # fmt: skip
+    else:
+        blocks = map(lanes, (det_j, K, C, psi, S, tangent))
+        _derivatives.py_func(
+            *blocks, shape_gradients, scale, with_hessian, lanes(gradient), lanes(jacobian_hessian)
+        )
     if order < 2:
         return BlockResult(energy, gradient, None)
-    shape_gradients = np.ascontiguousarray(element.shape_gradients, dtype=dtype)
     hessian = nodal_hessian(jacobian_hessian, shape_gradients, scale)
     return BlockResult(energy, gradient, hessian, jacobian_hessian)
 
@@ -131,17 +140,58 @@ def projected_hessian(
     return nodal_hessian(projected, np.ascontiguousarray(element.shape_gradients), scale)
 
 
+def nodal_hessian(
+    jacobian_hessian: np.ndarray, shape_gradients: np.ndarray, scale: np.ndarray
+) -> np.ndarray:
+    """``Σ_q w_q Bᵀ H_q B``: nodal Hessian ``(m, nen, 2, nen, 2)`` from the Hessians of
+    ``W(J)`` ``(m, q, 4, 4)``, the shape function gradients ``(q, nen, 2)`` and the
+    quadrature weights ``scale`` ``(q,)``."""
+    m, nen = jacobian_hessian.shape[0], shape_gradients.shape[1]
+    hessian = np.zeros((m, nen, 2, nen, 2), jacobian_hessian.dtype)
+    if compiled(m):
+        _nodal_hessian(jacobian_hessian, shape_gradients, scale, hessian)
+    else:
+        _nodal_hessian.py_func(lanes(jacobian_hessian), shape_gradients, scale, lanes(hessian))
+    return hessian
+
+
+def project_psd(jacobian_hessian: np.ndarray) -> None:
+    """Set the negative eigenvalues of every n × n block ``(m, q, n, n)`` to zero, in place.
+
+    Blocks with a positive, diagonally dominant diagonal are positive semi-definite already and
+    are left alone; the others are replaced by their symmetric part's projection (compiled:
+    cyclic Jacobi; below COMPILED_FROM cells: LAPACK's symmetric eigensolver, the same
+    projection to round-off).
+    """
+    if compiled(len(jacobian_hessian)):
+        _project_psd(jacobian_hessian)
+        return
+    h = jacobian_hessian
+    symmetric = 0.5 * (h + np.swapaxes(h, -1, -2))
+    n = h.shape[-1]
+    off = np.where(np.eye(n, dtype=bool), 0.0, np.abs(symmetric)).sum(axis=-1)
+    todo = ~np.all(np.diagonal(h, axis1=-2, axis2=-1) >= off, axis=-1)
+    if todo.any():
+        values, vectors = np.linalg.eigh(symmetric[todo])
+        kept = vectors * np.maximum(values, 0.0)[..., None, :]
+        h[todo] = kept @ np.swapaxes(vectors, -1, -2)
+
+
+# The loops below do one cell at a time, compiled; below COMPILED_FROM cells the same functions
+# run as Python over arrays with the cells on the last axis (vares._jit.lanes): every scalar of
+# a cell is then an array over the cells, so the bodies use elementwise arithmetic only and write
+# into arrays their caller made.
+
+
 @njit(cache=True)
-def _kinematics(pattern_nodes, shape_gradients, metric):  # pragma: no cover - compiled
+def _kinematics(pattern_nodes, shape_gradients, metric, det_j, K, C):  # pragma: no cover
     """``det J``, ``J⁻¹`` and ``C = J⁻ᵀ G J⁻¹`` at every quadrature point of every cell."""
     m, nen = pattern_nodes.shape[0], pattern_nodes.shape[1]
     nq = shape_gradients.shape[0]
-    det_j = np.empty((m, nq), pattern_nodes.dtype)
-    K = np.empty((m, nq, 2, 2), pattern_nodes.dtype)
-    C = np.empty((m, nq, 2, 2), pattern_nodes.dtype)
     for e in range(m):
         for q in range(nq):
-            j00 = j01 = j10 = j11 = 0.0 * pattern_nodes[e, 0, 0]
+            zero = 0.0 * pattern_nodes[e, 0, 0]  # one array each over the cells (no `a = b = …`)
+            j00, j01, j10, j11 = zero, zero + 0.0, zero + 0.0, zero + 0.0
             for a in range(nen):
                 x, y = pattern_nodes[e, a, 0], pattern_nodes[e, a, 1]
                 d0, d1 = shape_gradients[q, a, 0], shape_gradients[q, a, 1]
@@ -168,25 +218,22 @@ def _kinematics(pattern_nodes, shape_gradients, metric):  # pragma: no cover - c
             C[e, q, 0, 1] = k00 * gk01 + k10 * gk11
             C[e, q, 1, 0] = k01 * gk00 + k11 * gk10
             C[e, q, 1, 1] = k01 * gk01 + k11 * gk11
-    return det_j, K, C
 
 
 @njit(cache=True)
 def _derivatives(
-    det_j, K, C, psi, S, tangent, shape_gradients, scale, with_hessian
+    det_j, K, C, psi, S, tangent, shape_gradients, scale, with_hessian, gradient, jacobian_hessian
 ):  # pragma: no cover
-    """Nodal gradient, and the Hessian of ``W(J)`` at each quadrature point, ``(m, q, 4, 4)``
-    with index ``2 i + α`` for ``J_iα``, from the Eshelby form and its directional derivatives."""
-    m, nq = det_j.shape
+    """Add the nodal gradient into ``gradient`` ``(m, nen, 2)`` and write the Hessian of
+    ``W(J)`` at each quadrature point into ``jacobian_hessian`` ``(m, q, 4, 4)``, index
+    ``2 i + α`` for ``J_iα``, from the Eshelby form and its directional derivatives."""
+    m, nq = det_j.shape[0], det_j.shape[1]
     nen = shape_gradients.shape[1]
-    dtype = det_j.dtype
-    gradient = np.zeros((m, nen, 2), dtype)
-    jacobian_hessian = np.zeros((m, nq, 4, 4) if with_hessian else (1, 1, 4, 4), dtype)
-    sigma = np.empty((2, 2), dtype)
-    sigma_kt = np.empty((2, 2), dtype)
-    dC = np.empty((2, 2), dtype)
-    dS = np.empty((2, 2), dtype)
-    d_sigma = np.empty((2, 2), dtype)
+    sigma = np.empty_like(C[0, 0])  # (2, 2) of a cell, or of every cell
+    sigma_kt = np.empty_like(sigma)
+    dC = np.empty_like(sigma)
+    dS = np.empty_like(sigma)
+    d_sigma = np.empty_like(sigma)
     for e in range(m):
         for q in range(nq):
             d = det_j[e, q]
@@ -254,15 +301,13 @@ def _derivatives(
                             value -= (sigma[a, 0] * k[al, 0] + sigma[a, 1] * k[al, 1]) * k[b, i]
                             # ∂g_ab / ∂J_i,al
                             jacobian_hessian[e, q, 2 * i + al, 2 * a + b] = d * value
-    return gradient, jacobian_hessian
 
 
 @njit(cache=True)
-def nodal_hessian(jacobian_hessian, shape_gradients, scale):  # pragma: no cover
-    """``Σ_q w_q Bᵀ H_q B``: nodal Hessian ``(m, nen, 2, nen, 2)`` from ``(m, q, 4, 4)``."""
+def _nodal_hessian(jacobian_hessian, shape_gradients, scale, hessian):  # pragma: no cover
+    """Add ``Σ_q w_q Bᵀ H_q B`` into ``hessian`` ``(m, nen, 2, nen, 2)``."""
     m, nq = jacobian_hessian.shape[0], jacobian_hessian.shape[1]
     nen = shape_gradients.shape[1]
-    hessian = np.zeros((m, nen, 2, nen, 2), jacobian_hessian.dtype)
     for e in range(m):
         for q in range(nq):
             h = jacobian_hessian[e, q]
@@ -280,17 +325,11 @@ def nodal_hessian(jacobian_hessian, shape_gradients, scale):  # pragma: no cover
                                         * shape_gradients[q, b, be]
                                     )
                             hessian[e, a, kk, b, ll] += w * value
-    return hessian
 
 
 @njit(cache=True)
-def project_psd(jacobian_hessian):  # pragma: no cover
-    """Set the negative eigenvalues of every n × n block ``(m, q, n, n)`` to zero, in place
-    (cyclic Jacobi).
-
-    Blocks with a positive, diagonally dominant diagonal are positive semi-definite already and
-    are left alone.
-    """
+def _project_psd(jacobian_hessian):  # pragma: no cover
+    """:func:`project_psd` by cyclic Jacobi, block by block."""
     n = jacobian_hessian.shape[2]
     a = np.empty((n, n))
     v = np.empty((n, n))

@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+
+from ..._jit import compiled, njit
 
 
 def determinant(a: np.ndarray) -> np.ndarray:
@@ -52,7 +53,8 @@ class ReferenceElement:
     def jacobians(self, coordinates: np.ndarray, cells: np.ndarray, at: str = "quadrature"):
         """``∂x/∂ξ`` of every cell, ``(m, q, d, 2)`` for node coordinates ``(n, d)``."""
         grads = self.shape_gradients if at == "quadrature" else self.check_gradients
-        if coordinates.dtype != np.float64:  # complex-step checks take the general path
+        if coordinates.dtype != np.float64 or not compiled(len(cells)):
+            # complex-step checks and small meshes take the general path
             return np.swapaxes(coordinates[cells], 1, 2)[:, None] @ grads
         return _jacobians(np.ascontiguousarray(coordinates), np.ascontiguousarray(cells), grads)
 
