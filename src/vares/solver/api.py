@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from .._jit import compiled, sized_for
 from ..geometry.flatten import tutte
 from ..geometry.injectivity import AreaMisfit, Overlap, pattern_area_misfit, pattern_overlap
 from ..geometry.mesh import SurfaceMesh
@@ -119,6 +120,8 @@ def _load_kernels(mesh: SurfaceMesh, material: Hyperelastic, solver: str | None)
     Compiled kernels are cached on disk (numba), so only the first process compiles; later ones
     load them. Kept out of a solve's ``elapsed``."""
     started = time.perf_counter()
+    if not compiled(mesh.num_cells):  # a small mesh's kernels run as numpy: nothing to load
+        return 0.0
     for cell_type, cells in mesh.cells.items():
         key = (cell_type, type(material), solver)
         if key in _WARM:
@@ -127,7 +130,8 @@ def _load_kernels(mesh: SurfaceMesh, material: Hyperelastic, solver: str | None)
         nodes = cells[0]
         single = SurfaceMesh(mesh.points[nodes], {cell_type: np.arange(len(nodes))[None, :]})
         try:
-            _solve(single, material, 1.0, None, SolveOptions(linear_solver=solver), None, None)
+            with sized_for(True):  # the compiled kernels, as the mesh's own solve runs them
+                _solve(single, material, 1.0, None, SolveOptions(linear_solver=solver), None, None)
         except Exception:  # a warm-up only: the real solve reports any trouble
             pass
     return time.perf_counter() - started
