@@ -1,35 +1,37 @@
-"""The ``vares`` command: one module per subcommand, wired together here."""
+"""The ``vares`` command: one module per subcommand, wired together here.
+
+A run imports only its own subcommand's module (:func:`main`): building every command's
+options, and importing what they declare them from, took a tenth of a small job's time
+(docs/benchmarks.md). ``app``, the whole command line, is built when first asked for.
+"""
 
 from __future__ import annotations
 
+import importlib
+
 import typer
 
-from .batch import batch
-from .blank import drape_blank
-from .cut import cut
-from .drape import drape
-from .erect import erect
-from .evaluate import evaluate
-from .fabric import fabric_app
-from .fabrics import fabrics
-from .laminate import laminate
-from .panels import panels
-from .pattern import example, pattern
-from .run import run
+__all__ = ["app", "build_app", "main"]
 
-__all__ = ["app", "main"]
+app: typer.Typer  # the whole command line (built by the module's __getattr__)
 
-app = typer.Typer(
-    help="Cutting patterns of doubly curved membranes by the Variation of Reference Strategy.",
-    no_args_is_help=True,
-    add_completion=False,
-    pretty_exceptions_enable=False,
-)
-for command in (pattern, example, run, evaluate, fabrics, panels, cut, erect, batch, drape):
-    app.command()(command)
-app.command()(laminate)
-app.command("drape-blank")(drape_blank)
-app.add_typer(fabric_app, name="fabric")
+#: The subcommands in the order ``vares --help`` lists them: name → (module, function).
+COMMANDS = {
+    "pattern": (".pattern", "pattern"),
+    "example": (".pattern", "example"),
+    "run": (".run", "run"),
+    "evaluate": (".evaluate", "evaluate"),
+    "fabrics": (".fabrics", "fabrics"),
+    "panels": (".panels", "panels"),
+    "cut": (".cut", "cut"),
+    "erect": (".erect", "erect"),
+    "batch": (".batch", "batch"),
+    "drape": (".drape", "drape"),
+    "laminate": (".laminate", "laminate"),
+    "drape-blank": (".blank", "drape_blank"),
+}
+#: Groups of subcommands: name → (module, Typer app).
+GROUPS = {"fabric": (".fabric", "fabric_app")}
 
 
 def _print_version(value: bool) -> None:
@@ -40,13 +42,41 @@ def _print_version(value: bool) -> None:
         raise typer.Exit()
 
 
-@app.callback()
 def _options(
     version: bool = typer.Option(
         False, "--version", callback=_print_version, is_eager=True, help="Print the version."
     ),
 ) -> None:
     """Cutting patterns of doubly curved membranes by the Variation of Reference Strategy."""
+
+
+def build_app(only: str | None = None) -> typer.Typer:
+    """The command line, or the part of it that runs the subcommand ``only`` (the same
+    command, options and messages)."""
+    built = typer.Typer(
+        help="Cutting patterns of doubly curved membranes by the Variation of Reference Strategy.",
+        no_args_is_help=True,
+        add_completion=False,
+        pretty_exceptions_enable=False,
+    )
+    for name, (module, attribute) in COMMANDS.items():
+        if only in (None, name):
+            function = getattr(importlib.import_module(module, __package__), attribute)
+            built.command(name)(function)
+    for name, (module, attribute) in GROUPS.items():
+        if only in (None, name):
+            group = getattr(importlib.import_module(module, __package__), attribute)
+            built.add_typer(group, name=name)
+    built.callback()(_options)
+    return built
+
+
+def __getattr__(name: str) -> typer.Typer:
+    if name == "app":
+        value = build_app()
+        globals()["app"] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def main() -> None:
@@ -61,8 +91,10 @@ def main() -> None:
     import sys
 
     _keep_freed_memory()
+    first = sys.argv[1] if len(sys.argv) > 1 else None
+    command = build_app(first) if first in COMMANDS or first in GROUPS else build_app()
     try:
-        app()
+        command()
         code = 0
     except SystemExit as exit_:
         code = exit_.code
