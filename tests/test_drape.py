@@ -141,10 +141,11 @@ def test_plane_gives_a_square_grid_without_shear():
 def test_cylinder_with_warp_along_the_axis_has_no_shear(jittered):
     mesh = jittered_cylinder() if jittered else cylinder160(1.0, 2.0, 160.0, 32, 16)
     net = kinematic_net(mesh, [0.0, 1.0, 1.0], [0.0, 1.0, 0.0], 0.05)
-    assert net.valid.mean() > 0.95  # the yarns run along generators and circles: all of it
+    # the yarns run along generators and circles: all of it, and a row beyond each edge
+    assert net.reached.mean() > 0.95 and net.valid.sum() > 0.9 * net.valid.size
     shear = np.abs(net.node_shear)
     # a regular prism is developable exactly; jittered nodes on the cylinder make a polyhedron
-    # with small angle defects of either sign (measured: max 0.16°, mean 0.036°)
+    # with small angle defects of either sign (measured: max 0.13°, mean 0.027°)
     if jittered:
         assert np.nanmax(shear) < 0.3 and np.nanmean(shear) < 0.06
     else:
@@ -153,13 +154,15 @@ def test_cylinder_with_warp_along_the_axis_has_no_shear(jittered):
 
 def test_cylinder_with_oblique_warp_loses_its_shear_as_the_mesh_is_refined():
     # a developable surface: zero shear for any warp; on the prism the yarns' chords crossing
-    # its folds leave a shear that shrinks with the facets (measured: halves per refinement)
+    # its folds leave a shear that shrinks with the facets (measured: median 0.139°, 0.033°,
+    # 0.011° for 16, 32, 64 facets: the generators follow the smooth cylinder's helix, which
+    # crosses the folds)
     warp = [np.sin(np.radians(30)), np.cos(np.radians(30)), 0.0]
     medians = []
     for n in (16, 32, 64):
         net = kinematic_net(cylinder160(1.0, 2.0, 160.0, n, n // 2), [0, 1, 1], warp, 0.05)
         medians.append(np.nanmedian(np.abs(net.node_shear)))
-    assert medians[0] < 0.1
+    assert medians[0] < 0.2
     assert medians[1] < 0.6 * medians[0] and medians[2] < 0.6 * medians[1]
 
 
@@ -183,7 +186,7 @@ def test_sphere_net_follows_the_chebyshev_relation():
 
 def test_sphere_shear_near_the_seed_is_gauss_curvature_times_yarn_lengths():
     # a fine irregular cap (edges 0.65 mm), spacing 0.33 mm: near the seed γ ≈ K u v in all four
-    # quadrants and off the diagonal (measured: within 1.7 %, the mesh's lumpy curvature)
+    # quadrants and off the diagonal (measured: within 1.3 %, the mesh's lumpy curvature)
     mesh = irregular_cap(R, 30.0, 80, 0.3, 2)
     spacing = R * np.radians(30.0) / 80 / 2
     net = kinematic_net(mesh, [0, 0, R], [1, 0, 0], spacing, max_length=25.0)
@@ -239,8 +242,8 @@ def test_hemisphere_diagonals_agree_with_each_other_and_with_the_exact_net():
         polar = np.degrees(np.arccos(net.positions[si + k, sj + k, 2] / R))
         if polar > 75.0:
             break
-        assert np.ptp(diagonals) < 0.3, k  # measured ≤ 0.25° (mesh irregularity)
-        assert abs(np.mean(diagonals) - exact[k - 1, k - 1]) < 0.05, k
+        assert np.ptp(diagonals) < 0.15, k  # measured ≤ 0.076° (mesh irregularity)
+        assert abs(np.mean(diagonals) - exact[k - 1, k - 1]) < 0.02, k  # measured ≤ 0.0095°
     assert polar > 70.0
 
 
@@ -290,14 +293,14 @@ def test_given_generators_give_the_geodesic_net():
     geodesic = kinematic_net(mesh, [0, 0, R], [1, 0, 0], 2.0)
     given = kinematic_net(mesh, [0, 0, R], [1, 0, 0], 2.0, generators=(warp_yarn, fill_yarn))
     si, sj = given.seed
-    # the smooth meridians lie up to 0.035 mm off the faceted mould: the nets differ by about
-    # that much (measured 0.12° at most within 59° of the pole)
+    # the smooth meridians lie up to 0.035 mm off the faceted mould; the walked geodesics
+    # follow them (measured: the nets differ by 0.0023° at most within 59° of the pole)
     k = np.arange(3, 35)
     for su in (1, -1):
         for sv in (1, -1):
             a = given.node_shear[si + su * k, sj + sv * k]
             b = geodesic.node_shear[geodesic.seed[0] + su * k, geodesic.seed[1] + sv * k]
-            assert np.abs(a - b).max() < 0.25
+            assert np.abs(a - b).max() < 0.02
 
 
 def test_flat_pattern_areas_follow_the_shear():

@@ -7,10 +7,12 @@ flat pattern coordinates the net implies (the node's barycentric coordinates in 
 lies in, applied to that triangle's flat corners ``(u, v)``). Each net cell is split into two
 triangles along its diagonal from ``(i, j)`` to ``(i + 1, j + 1)``.
 
-Mesh nodes and cells outside the net (beyond its last row of cells, at the mould's edge or where a
-cell would have sheared to ±90°) are **extrapolated** from the nearest net triangle (linearly for
-the flat coordinates, as constants for the cell fields) when they lie within ``reach`` yarn
-spacings of a net node, and are NaN farther out; :attr:`KinematicDrape.node_in_net` and
+The net runs on up to one spacing beyond the mould's edge (in the planes of the boundary faces),
+so the mould's cells along its edge lie in complete net cells. Mesh nodes and cells outside the
+net (beyond its last row of cells, or where a cell would have sheared to ±90°) are
+**extrapolated** from the nearest net triangle (linearly for the flat coordinates, as constants
+for the cell fields) when they lie within ``reach`` yarn spacings of a net node, and are NaN
+farther out; :attr:`KinematicDrape.node_in_net` and
 :attr:`KinematicDrape.cell_in_net` say which were interpolated.
 """
 
@@ -124,7 +126,7 @@ def _locate_in_net(
     """
     from scipy.spatial import cKDTree
 
-    valid = net.valid
+    valid = net.reached  # the nodes just beyond the mould's edge too
     nodes = np.argwhere(valid)
     if len(nodes) < 3:
         raise DrapeError("the net has fewer than three nodes: the spacing is too large")
@@ -149,7 +151,7 @@ def _locate_chunk(net, nodes, queries, distance, nearest, limit):
     count = len(queries)
     cell = np.full((count, 3), -1, dtype=np.int64)
     weights = np.full((count, 3), np.nan)
-    valid = net.valid
+    valid = net.reached  # the nodes just beyond the mould's edge too
     distance, nearest = distance.reshape(count, -1), nearest.reshape(count, -1)
     nu, nv = valid.shape
     offsets = np.array([[-1, -1], [-1, 0], [0, -1], [0, 0]])

@@ -2,15 +2,15 @@
 
 The yarns are inextensible and free to shear at their crossings. From a **seed point** on the
 mould and a **warp direction** there, two generator yarns run from the seed along ±warp and ±fill
-(fill ⟂ warp in the seed's tangent plane): geodesics of the triangulated mould (potpourri3d's
-tracer: straightest paths on the polyhedral surface) or polylines the user gives. Along them the
-net nodes follow each other at the chord distance ``spacing``. Every other node ``(i, j)`` is the
-point of the mould at the distance ``spacing`` from both ``(i ∓ 1, j)`` and ``(i, j ∓ 1)`` (the
-intersection of two spheres with the surface, Mack & Taylor 1956, Van der Weeën 1991), on the side
-away from the diagonal node ``(i ∓ 1, j ∓ 1)``. On the triangle mesh that point is exact: the
-circle where the two spheres meet is intersected with the plane of a face, and the search walks
-across faces until the intersection lies inside the face it was computed with. The nodes are found
-by anti-diagonals ``|i| + |j| = k``, all nodes of one diagonal (in all four quadrants) at once.
+(fill ⟂ warp in the seed's tangent plane, of the node normals interpolated there): discrete
+geodesics (each node ``spacing`` from the one before, the chords turning only along the
+interpolated normal) or polylines the user gives. Every other node ``(i, j)`` is the point of the
+mould at the distance ``spacing`` from both ``(i ∓ 1, j)`` and ``(i, j ∓ 1)`` (Mack & Taylor 1956,
+Van der Weeën 1991), on the side away from ``(i ∓ 1, j ∓ 1)``: the circle where the two spheres
+meet, intersected with the plane of a face, the search walking across faces until the point lies
+inside the face it was computed with (exact on the triangle mesh). The net runs on up to one
+spacing beyond the mould's edge, in the planes of its boundary faces. Nodes are found by
+anti-diagonals ``|i| + |j| = k``, all nodes of one diagonal (in all four quadrants) at once.
 
 The shear angle is the decrease of the angle between the yarns from 90°, signed: the angle between
 the +warp and +fill yarns of the grid. On a surface of Gauss curvature ``K`` it is ``γ ≈ K u v``
@@ -24,6 +24,7 @@ nodes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -55,10 +56,14 @@ class DrapeError(ValueError):
 class KinematicNet:
     """The nodes of a kinematic drape on a ``(nu, nv)`` grid (warp index first).
 
-    ``positions`` ``(nu, nv, 3)``: the nodes on the mould, NaN where the net does not reach
-    (outside the mould, or beyond a cell that would shear to ±90°); ``faces`` ``(nu, nv)``: the
+    ``positions`` ``(nu, nv, 3)``: the nodes, NaN where the net does not reach (beyond the
+    mould's edge, or beyond a cell that would shear to ±90°); ``faces`` ``(nu, nv)``: the
     triangle of the (triangulated) mould each node lies in, −1 where there is none; ``seed``: the
-    grid index of the seed node; ``spacing``: the yarn spacing (length units of the mesh).
+    grid index of the seed node; ``spacing``: the yarn spacing (length units of the mesh). The
+    net runs on **beyond the mould's edge** by up to one spacing, in the planes of the boundary
+    faces it leaves: those nodes have positions but the face −1 (:attr:`reached`, not
+    :attr:`valid`), and they complete the net's cells over the edge, so that the net stops where
+    it leaves the mould, not a cell short of it.
     """
 
     positions: np.ndarray
@@ -68,8 +73,13 @@ class KinematicNet:
 
     @property
     def valid(self) -> np.ndarray:
-        """``(nu, nv)`` bool: where the net has a node."""
+        """``(nu, nv)`` bool: where the net has a node on the mould."""
         return self.faces >= 0
+
+    @property
+    def reached(self) -> np.ndarray:
+        """``(nu, nv)`` bool: where the net has a node, on the mould or just beyond its edge."""
+        return np.isfinite(self.positions[..., 0])
 
     @property
     def yarn_lengths(self) -> tuple[np.ndarray, np.ndarray]:
@@ -85,7 +95,7 @@ class KinematicNet:
         """The flat pattern of the nodes ``(nu, nv, 2)``: ``(u, v)``, NaN where there is no node."""
         u, v = self.yarn_lengths
         flat = np.stack(np.broadcast_arrays(u, v), axis=-1).astype(float)
-        flat[~self.valid] = np.nan
+        flat[~self.reached] = np.nan
         return flat
 
     @property
@@ -172,7 +182,8 @@ def kinematic_net(
     locator = FaceLocator(tri_mesh)
     size = float(np.linalg.norm(np.ptp(tri_mesh.points, axis=0)))
     face, bary, seed_point = locate_seed(tri_mesh, seed, locator)
-    normal, vertex = _seed_normal(tri_mesh, face, bary, size)
+    node_normals = _node_normals(tri_mesh)
+    normal = _smooth_normals(node_normals, triangles, np.array([face]), bary[None])[0]
     warp = np.asarray(warp_direction, dtype=float).reshape(3)
     length = float(np.linalg.norm(warp))
     warp = warp - (warp @ normal) * normal
@@ -183,12 +194,17 @@ def kinematic_net(
         )
     warp /= np.linalg.norm(warp)
     fill = np.cross(normal, warp)
+    walk = _Walk.of(tri_mesh, spacing)
     if generators is None:
         length = 2.0 * size if max_length is None else float(max_length)
-        yarns = _geodesic_generators(tri_mesh, face, bary, vertex, warp, fill, length)
+        yarns, beyond = _geodesic_generators(
+            walk, node_normals, face, seed_point, normal, (warp, fill), spacing, length
+        )
     else:
-        yarns = _given_generators(generators, seed_point, warp, fill)
-    warp_minus, warp_plus, fill_minus, fill_plus = (chord_nodes(y, spacing) for y in yarns)
+        halves = _given_generators(generators, seed_point, warp, fill)
+        yarns = [chord_nodes(y, spacing) for y in halves]
+        beyond = [np.zeros(len(y), dtype=bool) for y in yarns]
+    warp_minus, warp_plus, fill_minus, fill_plus = yarns
 
     nu = len(warp_minus) + 1 + len(warp_plus)
     nv = len(fill_minus) + 1 + len(fill_plus)
@@ -199,14 +215,15 @@ def kinematic_net(
     positions[:si, sj] = warp_minus[::-1]
     positions[si, sj + 1 :] = fill_plus
     positions[si, :sj] = fill_minus[::-1]
-    faces = np.full((nu, nv), -1, dtype=np.int64)
+    off = np.zeros((nu, nv), dtype=bool)  # beyond the mould's edge
+    off[si + 1 :, sj], off[:si, sj] = beyond[1], beyond[0][::-1]
+    off[si, sj + 1 :], off[si, :sj] = beyond[3], beyond[2][::-1]
+    planes = np.full((nu, nv), -1, dtype=np.int64)  # the face each node's walk ended in
     on_axes = np.isfinite(positions[..., 0])
-    faces[on_axes] = locator.locate(positions[on_axes])[0]
-    faces[si, sj] = face
-    corners = tri_mesh.points[triangles]
-    edge = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1).min()
-    steps = 64 + 8 * int(np.ceil(spacing / edge))  # a walk crosses about spacing / edge faces
-    _march(positions, faces, (si, sj), spacing, corners, triangles, steps)
+    planes[on_axes] = locator.locate(positions[on_axes])[0]
+    planes[si, sj] = face
+    _march(positions, planes, off, (si, sj), spacing, walk)
+    faces = np.where(off, -1, planes)
     return KinematicNet(positions, faces, (si, sj), float(spacing))
 
 
@@ -230,31 +247,87 @@ def locate_seed(
     return int(face), bary, point
 
 
-def _seed_normal(mesh: SurfaceMesh, face: int, bary: np.ndarray, size: float):
-    """The unit normal at the seed (the face's, or the mean of the faces round a node) and the
-    node the seed sits on (None if it lies inside a face or an edge)."""
+def _node_normals(mesh: SurfaceMesh) -> np.ndarray:
+    """Unit normals ``(n, 3)`` at the nodes: the sums of the area vectors of the faces round
+    each node (an area-weighted mean)."""
     triangles = mesh.cells["triangle"]
-    corner = int(np.argmax(bary))
-    node = int(triangles[face, corner])
     vectors = mesh.area_vectors()
-    if np.linalg.norm(mesh.points[node] - bary @ mesh.points[triangles[face]]) <= 1e-9 * size:
-        normal = vectors[(triangles == node).any(axis=1)].sum(axis=0)
-        return normal / np.linalg.norm(normal), node
-    return vectors[face] / np.linalg.norm(vectors[face]), None
+    normals = np.zeros((mesh.num_points, 3))
+    for corner in range(3):
+        np.add.at(normals, triangles[:, corner], vectors)
+    return normals / np.linalg.norm(normals, axis=1)[:, None]
 
 
-def _geodesic_generators(mesh, face, bary, vertex, warp, fill, length) -> list[np.ndarray]:
-    import potpourri3d as pp3d
+def _smooth_normals(node_normals, triangles, faces, bary) -> np.ndarray:
+    """The node normals interpolated at points ``faces`` ``(k,)``, ``bary`` ``(k, 3)``: unit
+    vectors ``(k, 3)`` that vary continuously over the mould, across its faces' sides too."""
+    normals = np.einsum("kc,kci->ki", bary, node_normals[triangles[faces]])
+    return normals / np.linalg.norm(normals, axis=1)[:, None]
 
-    tracer = pp3d.GeodesicTracer(mesh.points, mesh.cells["triangle"])
-    yarns = []
-    for direction in (-warp, warp, -fill, fill):
-        if vertex is not None:
-            path = tracer.trace_geodesic_from_vertex(vertex, direction * length)
-        else:
-            path = tracer.trace_geodesic_from_face(int(face), bary, direction * length)
-        yarns.append(np.asarray(path, dtype=float))
-    return yarns
+
+class _Walk(NamedTuple):
+    """A walk across the faces: their corners, unit normals, neighbours, triangles, and the
+    most faces a walk may cross."""
+
+    corners: np.ndarray
+    normals: np.ndarray
+    neighbours: np.ndarray
+    triangles: np.ndarray
+    max_steps: int
+
+    @classmethod
+    def of(cls, mesh: SurfaceMesh, spacing: float) -> _Walk:
+        triangles = mesh.cells["triangle"]
+        corners = mesh.points[triangles]
+        normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        normals /= np.linalg.norm(normals, axis=1)[:, None]
+        edge = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1).min()
+        steps = 64 + 8 * int(np.ceil(spacing / edge))  # a walk crosses about spacing / edge faces
+        return cls(corners, normals, face_neighbours(triangles), triangles, steps)
+
+
+def _geodesic_generators(
+    walk, node_normals, face, seed, seed_normal, directions, spacing, length
+) -> list[np.ndarray]:
+    """The generator yarns' nodes along −warp, +warp, −fill, +fill from ``seed``, each
+    ``(k, 3)`` without the seed, and which of them lie beyond the mould's edge ``(k,)``: every
+    node at the chord distance ``spacing`` from the one before, in the plane of the previous
+    chord and the interpolated normal there (the chords turn only along the surface's normal: a
+    discrete geodesic). The four are walked together until they leave the mould (the first node
+    beyond its edge, within ``spacing`` of it, is the last) or reach ``length``."""
+    warp, fill = directions
+    heading = np.array([-warp, warp, -fill, fill])
+    point = np.repeat(seed[None], 4, axis=0)
+    where = np.full(4, face, dtype=np.int64)
+    normal = np.repeat(seed_normal[None], 4, axis=0)
+    yarns: list[list[np.ndarray]] = [[], [], [], []]
+    beyond: list[list[bool]] = [[], [], [], []]
+    active = np.arange(4)
+    for _ in range(int(length / spacing)):
+        if not active.size:
+            break
+        along = (
+            heading[active]
+            - np.einsum("ki,ki->k", heading[active], normal[active])[:, None] * normal[active]
+        )
+        along /= np.linalg.norm(along, axis=1)[:, None]
+        across = normal[active]
+        radius = np.full(len(active), float(spacing))
+        found, faces, off = _circle_intersections(
+            point[active], radius, along, across, where[active], walk, beyond=spacing
+        )
+        ok = faces >= 0
+        rows = active[ok]
+        edge = set(active[ok & off].tolist())
+        heading[rows] = found[ok] - point[rows]
+        point[rows], where[rows] = found[ok], faces[ok]
+        bary, _ = barycentric(found[ok], walk.corners[faces[ok]])
+        normal[rows] = _smooth_normals(node_normals, walk.triangles, faces[ok], bary)
+        for r in rows:
+            yarns[r].append(point[r].copy())
+            beyond[r].append(r in edge)
+        active = rows[~np.isin(rows, list(edge))]
+    return [np.array(y).reshape(-1, 3) for y in yarns], [np.array(b, dtype=bool) for b in beyond]
 
 
 def _given_generators(generators, seed, warp, fill) -> list[np.ndarray]:
@@ -272,17 +345,16 @@ def _given_generators(generators, seed, warp, fill) -> list[np.ndarray]:
     return halves
 
 
-def _march(positions, faces, seed, spacing, corners, triangles, max_steps: int) -> None:
-    """Fill the nodes off the generator yarns in place, by anti-diagonals from the seed."""
+def _march(positions, faces, off, seed, spacing, walk: _Walk) -> None:
+    """Fill the nodes off the generator yarns in place, by anti-diagonals from the seed:
+    ``positions``, ``faces`` (the face each node's walk ended in) and ``off`` (the node lies
+    beyond the mould's edge, in that face's plane)."""
     nu, nv = faces.shape
     a, b = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
     i, j = a - seed[0], b - seed[1]
     level = np.abs(i) + np.abs(j)
     inner = (i != 0) & (j != 0)
     di, dj = np.sign(i), np.sign(j)
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals /= np.linalg.norm(normals, axis=1)[:, None]
-    neighbours = face_neighbours(triangles)
     for k in range(2, int(level.max(initial=0)) + 1):
         ta, tb = np.nonzero(inner & (level == k))
         ia, jb = ta - di[ta, tb], tb - dj[ta, tb]
@@ -291,26 +363,24 @@ def _march(positions, faces, seed, spacing, corners, triangles, max_steps: int) 
         ta, tb, ia, jb, start = ta[ready], tb[ready], ia[ready], jb[ready], start[ready]
         if not ta.size:
             continue
-        point, face = _sphere_intersections(
+        point, face, beyond = _sphere_intersections(
             positions[ia, jb],
             positions[ia, tb],
             positions[ta, jb],
             start,
             spacing,
-            corners,
-            normals,
-            neighbours,
-            max_steps,
+            walk,
         )
         positions[ta, tb] = point
         faces[ta, tb] = face
+        off[ta, tb] = beyond
 
 
-def _sphere_intersections(p0, p1, p2, start, spacing, corners, normals, neighbours, max_steps):
+def _sphere_intersections(p0, p1, p2, start, spacing, walk: _Walk):
     """The points ``(k, 3)`` of the mesh at the distance ``spacing`` from both ``p1`` and ``p2``
-    ``(k, 3)``, on the side away from ``p0``, and their faces ``(k,)`` (NaN and −1 where there is
-    none), walking from the faces ``start``."""
-    count = len(p1)
+    ``(k, 3)``, on the side away from ``p0``, their faces ``(k,)`` (NaN and −1 where there is
+    none) and whether they lie beyond the mould's edge ``(k,)`` (:func:`_circle_intersections`,
+    within ``spacing``), walking from the faces ``start``."""
     chord = p2 - p1
     distance = np.linalg.norm(chord, axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -323,13 +393,30 @@ def _sphere_intersections(p0, p1, p2, start, spacing, corners, normals, neighbou
     with np.errstate(invalid="ignore", divide="ignore"):
         along = away / np.linalg.norm(away, axis=1)[:, None]
     across = np.cross(e, along)
-    point = np.full((count, 3), np.nan)
-    found = np.full(count, -1, dtype=np.int64)
-    face, previous = start.copy(), np.full(count, -1, dtype=np.int64)
     # the rhombus (p0, p1, ·, p2) has the yarn angle 2 arcsin(distance / 2 spacing) at p0:
     # distance → 0 or → 2 spacing is a cell sheared to ±90°, where the net ends
-    active = np.flatnonzero((radius_sq > 1e-12 * spacing**2) & (distance > 1e-6 * spacing))
-    for _ in range(max_steps):
+    usable = (radius_sq > 1e-12 * spacing**2) & (distance > 1e-6 * spacing)
+    return _circle_intersections(centre, radius, along, across, start, walk, usable, beyond=spacing)
+
+
+def _circle_intersections(
+    centre, radius, along, across, start, walk: _Walk, usable=None, beyond: float = 0.0
+):
+    """The points ``(k, 3)`` where the circles ``centre + radius (cos θ along + sin θ across)``
+    (``(k, 3)``, ``(k,)``, unit ``along`` ⟂ ``across``) meet the mesh, the root nearer to
+    ``along``, their faces ``(k,)`` (NaN and −1 where there is none, or not ``usable``), and
+    ``(k,)`` whether the point lies beyond the mould's edge: a walk that would leave the mould
+    across a boundary side takes the root in the plane of the boundary face when it lies within
+    ``beyond`` of that face (the net runs on over the edge), else none; walking from the faces
+    ``start``."""
+    corners, normals, neighbours = walk.corners, walk.normals, walk.neighbours
+    count = len(centre)
+    point = np.full((count, 3), np.nan)
+    found = np.full(count, -1, dtype=np.int64)
+    off = np.zeros(count, dtype=bool)
+    face, previous = start.copy(), np.full(count, -1, dtype=np.int64)
+    active = np.arange(count) if usable is None else np.flatnonzero(usable)
+    for _ in range(walk.max_steps):
         if not active.size:
             break
         f = face[active]
@@ -356,10 +443,20 @@ def _sphere_intersections(p0, p1, p2, start, spacing, corners, normals, neighbou
             clamped = np.clip(lam[back], 0.0, None)
             clamped /= clamped.sum(axis=1, keepdims=True)
             q[back] = np.einsum("kc,kci->ki", clamped, corners[f[back]])
-        done = (inside | back) & reaches
+        outside = ~inside & ~back & (step < 0) & reaches
+        if beyond > 0 and outside.any():
+            clamped = np.clip(lam[outside], 0.0, None)
+            clamped /= clamped.sum(axis=1, keepdims=True)
+            foot = np.einsum("kc,kci->ki", clamped, corners[f[outside]])
+            near = np.linalg.norm(q[outside] - foot, axis=1) <= beyond
+            off[active[np.flatnonzero(outside)[near]]] = True
+            outside[np.flatnonzero(outside)[~near]] = False
+        else:
+            outside[:] = False
+        done = (inside | back | outside) & reaches
         point[active[done]], found[active[done]] = q[done], f[done]
         moving = ~inside & ~back & (step >= 0)
         previous[active[moving]] = f[moving]
         face[active[moving]] = step[moving]
         active = active[moving]
-    return point, found
+    return point, found, off
