@@ -1,7 +1,10 @@
 """``vares drape``: the kinematic drape of a woven ply on a mould, its producibility, and its
 darts (``--darts auto`` or ``--dart-lines FILE``: the ply's pattern solved with its fabric, then
-again with the darts open)."""
+again with the darts open). ``--example NAME`` drapes a shipped mould (:data:`DRAPE_EXAMPLES`)
+from its own seed, warp and spacing."""
 
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -16,7 +19,55 @@ from .common import console, guarded
 from .flags import InputError, build, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
-__all__ = ["darts_verdict", "drape"]
+__all__ = ["DRAPE_EXAMPLES", "DrapeExample", "darts_verdict", "drape"]
+
+
+@dataclass(frozen=True)
+class DrapeExample:
+    """A shipped mould to drape: its mesh (``make()``), the seed ``(3,)`` (``seed()``; None: the
+    node nearest the nodes' centroid), warp ``(3,)`` and yarn spacing it is draped with unless
+    the flags say otherwise, and the units of its coordinates."""
+
+    make: Callable[[], Any]
+    seed: Callable[[], tuple[float, float, float] | None]
+    warp: tuple[float, float, float]
+    spacing: float
+    units: str
+
+
+def _hemisphere():
+    from ...geometry.examples import irregular_cap
+
+    return irregular_cap(100.0, 90.0, 30, 0.3, 1)
+
+
+def _double_dome():
+    from ...geometry.examples import double_dome
+
+    return double_dome()
+
+
+def _rib():
+    from ...geometry.examples import rib30
+
+    return rib30()
+
+
+def _saddle_centre() -> tuple[float, float, float]:
+    from ...geometry.examples import double_dome_height
+
+    return (0.0, 0.0, float(double_dome_height(np.zeros(1), np.zeros(1))[0]))
+
+
+#: The moulds ``vares drape --example`` takes (docs/composites.md): the hemisphere R = 100 mm to
+#: the equator (30 rings of irregular triangles) from its pole, the double dome from the
+#: saddle's centre (on both planes of symmetry), both with the warp along x; the seed's rib
+#: (in metres) with the warp along it.
+DRAPE_EXAMPLES: dict[str, DrapeExample] = {
+    "hemisphere": DrapeExample(_hemisphere, lambda: (0.0, 0.0, 100.0), (1.0, 0.0, 0.0), 2.0, "mm"),
+    "double-dome": DrapeExample(_double_dome, _saddle_centre, (1.0, 0.0, 0.0), 2.0, "mm"),
+    "rib": DrapeExample(_rib, lambda: None, (0.0, 1.0, 0.0), 0.004, "m"),
+}
 
 OUTPUT_FLAGS = [
     option_parameter(
@@ -38,27 +89,49 @@ OUTPUT_FLAGS = [
     ),
     option_parameter(
         "units",
-        "mm",
-        str,
+        None,
+        str | None,
         "--units",
-        help="Units of the mould's coordinates, for pattern.dxf (" + ", ".join(METRES) + ").",
+        help="Units of the mould's coordinates, for pattern.dxf (" + ", ".join(METRES) + "; "
+        "default mm, an example's own).",
         panel="Output",
     ),
 ]
 
+EXAMPLE_FLAG = [
+    option_parameter(
+        "example",
+        None,
+        str | None,
+        "--example",
+        help="Drape a shipped mould instead, from its own seed, warp and spacing unless given: "
+        + ", ".join(DRAPE_EXAMPLES)
+        + ".",
+        panel="Input",
+    )
+]
+
 
 @with_flags(
-    flags(DrapeOptions), flags(DartOptions), flags(MaterialOptions), OUTPUT_FLAGS, RUN_FLAGS[1:]
+    EXAMPLE_FLAG,
+    flags(DrapeOptions),
+    flags(DartOptions),
+    flags(MaterialOptions),
+    OUTPUT_FLAGS,
+    RUN_FLAGS[1:],
 )
 def drape(
-    surface: Annotated[Path, typer.Argument(help="The mould's surface mesh.")],
+    surface: Annotated[
+        Path | None, typer.Argument(help="The mould's surface mesh (or --example).")
+    ] = None,
     **values: Any,
 ) -> None:
     """Drape a woven ply kinematically (pin-jointed net) and check its producibility.
 
     Writes drape.json (the producibility and the net) and drape.vtu (the mould with the shear
     angle, the producibility class, the yarn directions and the flat pattern per node) into the
-    output directory. With --darts auto or --dart-lines the ply's pattern is solved with its
+    output directory. --example drapes a shipped mould (hemisphere, double-dome, rib). With
+    --darts auto or --dart-lines the ply's pattern is solved with its
     fabric (--fabric, or --material and its parameters), darts are opened where its shear
     reaches the locking angle (or along the given lines) and it is solved again: drape.json
     gets the darts, and darts.vtu (the mould cut open), pattern.dxf (the pattern with layer
@@ -72,17 +145,34 @@ def drape(
         from ...io.meshes import read_mesh, write_surface
         from ..staging import OutputFolder
 
+        name = values["example"]
+        if (surface is None) == (name is None):
+            raise InputError("give a mould file or --example, not both and not neither")
+        example = None
+        if name is not None:
+            if name not in DRAPE_EXAMPLES:
+                known = ", ".join(DRAPE_EXAMPLES)
+                raise InputError(f"--example must be one of {known}; got {name!r}")
+            example = DRAPE_EXAMPLES[name]
         options = build(DrapeOptions, values)
+        if example is not None:
+            options = options.replace(
+                seed=options.seed if options.seed is not None else example.seed(),
+                warp=options.warp if options.warp is not None else example.warp,
+                spacing=options.spacing if options.spacing is not None else example.spacing,
+            )
         darting = build(DartOptions, values)
         material = _material(values, darting)
-        if values["units"] not in METRES:
-            raise InputError(f"--units must be one of {', '.join(METRES)}; got {values['units']!r}")
+        units = values["units"] or (example.units if example is not None else "mm")
+        if units not in METRES:
+            raise InputError(f"--units must be one of {', '.join(METRES)}; got {units!r}")
         polylines = None
         if darting.dart_lines is not None:
             from ...io.curves import read_curves
 
             polylines = read_curves(darting.dart_lines)
-        mesh = read_mesh(surface)
+        mesh = read_mesh(surface) if example is None else example.make()
+        label = surface.stem if example is None else name
         output = values["output"]
         paths = [output / "drape.json", output / "drape.vtu"]
         dart_paths = [output / "darts.vtu", output / "pattern.dxf", output / "darts.png"]
@@ -90,13 +180,13 @@ def drape(
             paths += dart_paths
         if values["report"]:
             paths.append(output / "drape.html")
-        folder = OutputFolder(
-            output, paths, force=values["force"], inputs=[surface], command="drape"
-        )
+        inputs = [] if surface is None else [surface]
+        folder = OutputFolder(output, paths, force=values["force"], inputs=inputs, command="drape")
         folder.check()
         ply = drape_ply(mesh, options)
         check, result = ply.producibility, ply.drape
-        data = {"surface": str(surface), **ply.summary()}
+        source = {"surface": str(surface)} if example is None else {"example": name}
+        data = {**source, **ply.summary()}
         data["producibility_codes"] = {name: code for code, name in enumerate(CLASSES)}
         fields = {
             "shear_angle": result.shear_angle,
@@ -126,11 +216,11 @@ def drape(
             write_surface(folder.staged(paths[1]), mesh, None, fields, point_data)
             write_json(folder.staged(paths[0]), data)
             if darted is not None:
-                _write_darts(folder, dart_paths, darted, values["units"], surface.stem)
+                _write_darts(folder, dart_paths, darted, units, label)
             if values["report"]:
                 from ..drape_report import drape_page
 
-                html = drape_page(ply, darted, surface.stem, values["units"])
+                html = drape_page(ply, darted, label, units)
                 folder.staged(paths[-1]).write_text(html, encoding="utf-8")
             folder.commit()
         finally:
