@@ -22,7 +22,6 @@ import numpy as np
 from ..geometry.elements import ELEMENTS
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
-from ..mechanics.assembly import Assembler
 from ..mechanics.erection import Cables, ErectionProblem
 from ..mechanics.wrinkling import WrinklingError
 from ..options import split_settings, takes_options
@@ -33,7 +32,8 @@ from ..solver.result import IterationRecord, PatternResult, StepRecord
 from ..solver.reuse import ETA_MAX, ETA_MAX_KINKED, ReusingSolver
 from ..solver.strategies import Attempt, follow_plan
 from .erection_fields import erection_statistics, membrane_forces, node_normals
-from .erection_model import Pattern, Structure, build_structure, patterns_of
+from .erection_model import Pattern, Structure, build_structure, dof_map, patterns_of
+from .erection_trials import PrimedSolver
 from .options import ErectionOptions
 
 __all__ = ["ErectionResult", "Pattern", "erect", "erection_defaults"]
@@ -205,6 +205,7 @@ def erect(
     options: ErectionOptions | None = None,
     start: np.ndarray | None = None,
     callback: Callable[[IterationRecord], None] | None = None,
+    primer: Callable[[np.ndarray], np.ndarray] | None = None,
     **settings: Any,
 ) -> ErectionResult:
     """Build the structure from its patterns and solve for the shape it settles into.
@@ -223,6 +224,11 @@ def erect(
         from instead of the design shape; held nodes stay at their design positions.
     callback
         Called with every Newton iteration's record (progress display).
+    primer
+        A solve with the factorised tangent of a nearby erected state (free dofs, as
+        ``ErectionResult.context``'s): Newton's steps are solved by conjugate gradients
+        preconditioned by it while that takes a few iterations
+        (:class:`~vares.analysis.erection_trials.PrimedSolver`).
     options, settings
         :class:`ErectionOptions` and any of its fields as keywords (listed below).
 
@@ -247,6 +253,8 @@ def erect(
         pressure=options.pressure,
     )
     ctx = _context(problem, held, solver, callback, options.erection_iterations)
+    if primer is not None:
+        ctx.systems = PrimedSolver(ctx.systems, primer)
     x, path, reason = design.copy(), [], None
     if start is not None:
         x[~held] = _checked_start(start, design)[~held]
@@ -347,7 +355,7 @@ def _context(
     solver, the erection's own iteration limit."""
     material = problem.material
     return NewtonContext(
-        assembler=Assembler(problem.connectivity, np.repeat(~held, 3), dofs_per_node=3),
+        assembler=dof_map(problem.connectivity, np.repeat(~held, 3)),
         linear_solver=get_solver(solver.linear_solver),
         residual_tolerance=solver.tolerance * problem.force_scale,
         energy_noise=ENERGY_NOISE

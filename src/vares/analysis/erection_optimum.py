@@ -8,9 +8,12 @@ shape, by least squares (:mod:`vares.analysis.erection_residuals`):
 
     J(X) = Σ_cells A_e Σ_yarn (n(x*, X) − n_intended)² / (A s₀²)
            + 30 Σ_yarn (mean n − mean n_intended)² / s₀²
+           + 3 Σ_cells A_e min(0, m_e − 0.1 min n_intended)² / (A s₀²)
            + w Σ_nodes a_i d_i(x*)² / (A d₀²) + 100 Σ_{|d_i| > b} a_i (|d_i| − b)² / (A d₀²)
 
-``n`` the membrane forces along warp and fill, ``d`` the normal deviation from the design, ``A_e``
+``n`` the membrane forces along warp and fill, ``m_e`` the cell's smaller principal force of the
+plain law (negative where the erected membrane wrinkles or hangs slack: an optimum does not buy
+its forces with wrinkles), ``d`` the normal deviation from the design, ``A_e``
 and ``a_i`` the cells' and nodes' design areas, ``s₀`` and ``d₀`` the RMS force deviation and RMS
 shape deviation of the starting patterns' erection (``shape_weight`` ``w`` weighs a relative gain
 in shape against one in force), ``b`` the bound on the shape deviation (``shape_bound`` × the
@@ -29,10 +32,13 @@ LSQR solves each step's least-squares problem, preconditioned by the inverse of 
 patterns' stiffness (:func:`~vares.analysis.erection_residuals.stiffness_preconditioner`: 15
 iterations make the step 30 plain ones made). A trial step's erection starts from the erected
 state moved by its linearised change ``dx*`` (Newton's method then needs fewer iterations than
-from the last state), and only an accepted state is linearised. It stops when a step lowers
-``J`` by less than ``tolerance`` of it, when nothing is left above round-off, or after
-``optimise_iterations`` steps. Patterns stay one-to-one (a step that inverts a pattern cell is
-refused like one that raises ``J``).
+from the last state), is solved by conjugate gradients preconditioned by the accepted state's
+factorised tangent, and only as accurately as the test of its objective needs
+(:mod:`vares.analysis.erection_trials`); only an accepted state is linearised, and the optimum
+is erected to the full tolerance at the end. It stops when a step lowers ``J`` (or the
+Gauss–Newton model promises to lower it) by less than ``tolerance`` of it, when nothing is left
+above round-off, or after ``optimise_iterations`` steps. Patterns stay one-to-one (a step that
+inverts a pattern cell is refused like one that raises ``J``).
 """
 
 from __future__ import annotations
@@ -64,6 +70,7 @@ from .erection_residuals import (
     seam_edges,
     stiffness_preconditioner,
 )
+from .erection_trials import ACCEPTANCE_ACCURACY, TRIAL_TOLERANCE, predicted_positions
 from .options import ErectionOptions
 
 __all__ = ["OptimisedPatterns", "OptimumRecord", "optimise_for_erection", "optimised_results"]
@@ -75,6 +82,10 @@ INITIAL_DAMPING = 1e-3
 INITIAL_STEP_STRAIN = 0.1
 MAX_STEP_STRAIN = 0.2
 MIN_STEP_STRAIN = 1e-4
+#: A step whose Gauss–Newton model promises to lower ``J`` by less than this fraction of the
+#: tolerance (of ``J``) ends the optimisation before its trial is erected: its actual gain
+#: would not pass the tolerance either (the gains of the last steps are 0.25–0.95).
+PROMISED_GAIN = 1.0
 #: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
 LSQR_TOLERANCE = 1e-3
 LSQR_LIMIT = 15
@@ -90,8 +101,9 @@ SHAPE_FLOOR = 1e-11
 class OptimumRecord:
     """One iteration: the objective ``J`` and its force and shape parts, the erected RMS force
     deviation, the largest and RMS shape deviation, the largest seam mismatch (length units),
-    the damping ``μ``, LSQR's iterations, whether the step was taken and the Newton iterations
-    of its trial erection."""
+    the damping ``μ``, LSQR's iterations, whether the step was taken, the Newton iterations
+    of its trial erection, the gain ratio (the decrease of ``J`` against the Gauss–Newton
+    model's) and the step's largest edge strain."""
 
     iteration: int
     objective: float
@@ -105,6 +117,8 @@ class OptimumRecord:
     lsqr_iterations: int
     accepted: bool
     erection_iterations: int = 0
+    gain: float = 0.0
+    step_strain: float = 0.0
 
 
 @dataclass
@@ -155,8 +169,10 @@ class OptimisedPatterns:
         }
 
 
-def _erect(patterns, material, thickness, solver, options, start):
-    return erect(patterns, material, thickness, solver=solver, options=options, start=start)
+def _erect(patterns, material, thickness, solver, options, start, primer=None):
+    return erect(
+        patterns, material, thickness, solver=solver, options=options, start=start, primer=primer
+    )
 
 
 @takes_options(ErectionOptions)
@@ -260,12 +276,13 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         scale = min(1.0, radius / step_strain) if step_strain > 0 else 1.0
         change, dx = model.response(scale * step)
         predicted = objective - float(np.sum((model.residual + change) ** 2))
-        if predicted < 0.1 * tolerance * objective:
-            converged = True  # the model promises no more
+        if predicted < PROMISED_GAIN * tolerance * objective:
+            converged = True  # the model promises less than a step must gain
             break
         trial = matched(moved(current, layout.split(scale * step)), seams, layout)
+        loose = _trial_solver(solver, model, erected, predicted)
         attempt, newton = _trial_erection(
-            trial, material, thickness, solver, options, erected, _predicted(erected, dx)
+            trial, material, thickness, loose, options, erected, model, dx
         )
         accepted, decrease, gain = False, 0.0, -1.0
         if attempt is not None:
@@ -289,6 +306,7 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         record = _record(
             iteration, objective, model, erected, current, seams, mu, lsqr_its, accepted, newton
         )
+        record = replace(record, gain=gain, step_strain=taken)
         history.append(record)
         if callback is not None:
             callback(record)
@@ -301,6 +319,8 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         converged = True  # every step taken lowered the objective: the patterns are usable
     if not converged:
         reason = "no step lowers the objective"
+    if erected is not first and TRIAL_TOLERANCE > solver.tolerance:  # trials erected loosely
+        erected = _tightened(current, material, thickness, solver, options, erected)
     overlap = _overlapping(current)
     if overlap is not None:  # a pattern that laps over itself is no cutting pattern
         current, erected, converged, reason = patterns, first, False, overlap
@@ -366,27 +386,43 @@ def _norm_squared(op, iterations: int = 4) -> float:
     return value
 
 
-def _predicted(erected: ErectionResult, dx: np.ndarray) -> np.ndarray:
-    """The erected positions ``(n, 3)`` moved by the linearised change ``dx`` (free dofs)."""
-    x = erected.erected_points.copy()
-    x.reshape(-1)[erected.context.assembler.free] += dx
-    return x
-
-
-def _trial_erection(trial, material, thickness, solver, options, erected, predicted):
+def _trial_erection(trial, material, thickness, solver, options, erected, model, dx):
     """The erection of trial patterns from the linearised prediction of their erected state
-    (from the last erected state where that fails) and its Newton iterations, or ``(None, n)``
-    where a pattern cell turned over or the erection did not converge."""
+    (from the last erected state where that fails), its Newton steps preconditioned by the
+    accepted state's factorised tangent (:mod:`vares.analysis.erection_trials`), and its Newton
+    iterations, or ``(None, n)`` where a pattern cell turned over or the erection did not
+    converge."""
     newton = 0
-    for start in (predicted, erected.erected_points):
+    for start in (predicted_positions(erected, dx), erected.erected_points):
         try:
-            attempt = _erect(trial, material, thickness, solver, options, start)
+            attempt = _erect(
+                trial, material, thickness, solver, options, start, model.tangent_solve
+            )
         except ValueError:  # a pattern cell turned over
             return None, newton
         newton += attempt.iterations
         if attempt.converged:
             return attempt, newton
     return None, newton
+
+
+def _trial_solver(solver, model, erected, predicted):
+    """The solver options of a trial's erection: its residual tolerance as loose as keeps the
+    objective's error (at most ``2 |g| |R|``, :meth:`ResidualModel.equilibrium_sensitivity`)
+    within :data:`ACCEPTANCE_ACCURACY` of the step's predicted decrease, between the solver's
+    own tolerance and :data:`TRIAL_TOLERANCE`."""
+    if TRIAL_TOLERANCE <= solver.tolerance:
+        return solver
+    bound = ACCEPTANCE_ACCURACY * predicted / (2.0 * model.equilibrium_sensitivity())
+    tolerance = min(TRIAL_TOLERANCE, bound / erected.problem.force_scale)
+    return replace(solver, tolerance=max(solver.tolerance, tolerance))
+
+
+def _tightened(patterns, material, thickness, solver, options, erected):
+    """The erection of the optimised patterns to the solver's tolerance, from their loosely
+    erected state (one or two Newton iterations); that state where this one fails."""
+    tight = _erect(patterns, material, thickness, solver, options, erected.erected_points)
+    return tight if tight.converged else erected
 
 
 def _record(

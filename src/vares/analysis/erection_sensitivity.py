@@ -35,6 +35,9 @@ __all__ = [
     "BlockDerivatives",
     "block_derivatives",
     "block_forces",
+    "block_least_forces",
+    "least_force",
+    "least_force_gradients",
     "yarn_force",
     "yarn_force_gradients",
 ]
@@ -45,12 +48,16 @@ class BlockDerivatives:
     """Per membrane block at an erected state: ``mixed`` ``∂r/∂X`` ``(m, nen, 3, nen, 2)``, the
     membrane forces along warp and fill ``forces`` ``(m, 2)`` and their derivatives by the
     nodes' positions ``force_by_x`` ``(m, 2, nen, 3)`` and by the pattern ``force_by_X``
-    ``(m, 2, nen, 2)``."""
+    ``(m, 2, nen, 2)``; where asked for, the plain law's smaller principal force ``least``
+    ``(m,)`` (:func:`block_least_forces`) and its derivatives ``(m, nen, 3)``, ``(m, nen, 2)``."""
 
     mixed: np.ndarray
     forces: np.ndarray
     force_by_x: np.ndarray
     force_by_X: np.ndarray
+    least: np.ndarray | None = None
+    least_by_x: np.ndarray | None = None
+    least_by_X: np.ndarray | None = None
 
 
 def yarn_force(C: np.ndarray, S: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -95,6 +102,47 @@ def yarn_force_gradients(
     return n, by_C, by_S
 
 
+def least_force(C: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """The smaller principal Cauchy stress ``λ_min(S C)/√det C`` at states ``C``, ``S``
+    ``(..., 2, 2)`` (``S C`` has the eigenvalues of ``F S Fᵀ`` in the surface; real or
+    complex)."""
+    return _least(C, S)[0]
+
+
+def _least(C, S):
+    det_c = C[..., 0, 0] * C[..., 1, 1] - C[..., 0, 1] * C[..., 1, 0]
+    det_s = S[..., 0, 0] * S[..., 1, 1] - S[..., 0, 1] * S[..., 1, 0]
+    half = 0.5 * np.einsum("...ab,...ab->...", S, C)  # tr(S C) / 2
+    q = np.sqrt(half**2 - det_s * det_c)
+    root = np.sqrt(det_c)
+    return (half - q) / root, det_c, det_s, half, q, root
+
+
+def _cofactors(A: np.ndarray) -> np.ndarray:
+    return np.stack(
+        [np.stack([A[..., 1, 1], -A[..., 1, 0]], -1), np.stack([-A[..., 0, 1], A[..., 0, 0]], -1)],
+        -2,
+    )
+
+
+def least_force_gradients(C: np.ndarray, S: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`least_force` ``m`` and its derivatives ``∂m/∂C``, ``∂m/∂S`` ``(..., 2, 2)``,
+    entry by entry: with ``h = tr(SC)/2``, ``q = √(h² − det S det C)``, ``λ = h − q``,
+    ``∂λ/∂C = (1 − h/q) S/2 + det S cof C/(2q)``, ``∂λ/∂S = (1 − h/q) C/2 + det C cof S/(2q)``
+    and ``m = λ/√det C`` (``q`` is kept above round-off where the two principal forces are
+    equal; ``tests/test_erection_optimum.py`` checks them by complex step)."""
+    m, det_c, det_s, half, q, root = _least(C, S)
+    q = np.maximum(q, 1e-12 * (np.abs(half) + 1e-300))
+    along = (1.0 - half / q)[..., None, None]
+    by_C = (0.5 * along * S + (det_s / (2.0 * q))[..., None, None] * _cofactors(C)) / root[
+        ..., None, None
+    ] - (0.5 * m / det_c)[..., None, None] * _cofactors(C)
+    by_S = (0.5 * along * C + (det_c / (2.0 * q))[..., None, None] * _cofactors(S)) / root[
+        ..., None, None
+    ]
+    return m, by_C, by_S
+
+
 def _points(problem: ErectionProblem, index: int, x: np.ndarray, tangent: bool):
     block: MembraneBlock = problem.blocks[index]
     G, w = block.reference.gradients, block.reference.weights  # (m,q,nen,2), (m,q)
@@ -119,9 +167,26 @@ def block_forces(problem: ErectionProblem, index: int, x: np.ndarray) -> np.ndar
     return problem.thickness * np.stack(forces, axis=1)
 
 
-def block_derivatives(problem: ErectionProblem, index: int, x: np.ndarray) -> BlockDerivatives:
+def block_least_forces(problem: ErectionProblem, index: int, x: np.ndarray) -> np.ndarray:
+    """The plain law's smaller principal membrane force, cell means ``(m,)``, of membrane block
+    ``index`` at ``x``: negative where the erected membrane is wrinkled or slack (the relaxed
+    law's is zero there), the compression the plain law would carry across the wrinkles."""
+    block = problem.blocks[index]
+    G, w = block.reference.gradients, block.reference.weights
+    F = deformation_gradients(np.ascontiguousarray(x[block.cells]), G)
+    C = np.swapaxes(F, -1, -2) @ F
+    _, S, _ = problem.response(block.fibres, relaxed=False)(C, False)
+    m = least_force(C, np.broadcast_to(S, C.shape))
+    return problem.thickness * np.sum(w * m, axis=1) / w.sum(axis=1)
+
+
+def block_derivatives(
+    problem: ErectionProblem, index: int, x: np.ndarray, with_least: bool = False
+) -> BlockDerivatives:
     """The derivatives (:class:`BlockDerivatives`) of membrane block ``index`` of ``problem``
-    at the erected positions ``x`` ``(n, 3)``, with the problem's law (relaxed or plain)."""
+    at the erected positions ``x`` ``(n, 3)``, with the problem's law (relaxed or plain);
+    ``with_least``: also the plain law's smaller principal force (:func:`block_least_forces`)
+    and its derivatives."""
     block, G, w, F, C, S, cc = _points(problem, index, x, True)
     cc = np.broadcast_to(cc, (*C.shape, 2, 2))
     # δC per pattern dof (b, α): −(G_bβ C_αγ + C_βα G_bγ)
@@ -140,28 +205,52 @@ def block_derivatives(problem: ErectionProblem, index: int, x: np.ndarray) -> Bl
         - np.einsum("mqca,mqbi->mciba", w[..., None, None] * G, FSG)
     )
     t = problem.thickness
-    total = w.sum(axis=1)
     forces, by_x, by_X = [], [], []
     for direction in _directions(block):
         n, by_C, by_S = yarn_force_gradients(C, S, direction)  # (m, q), (m, q, 2, 2) ×2
         D = by_C + 0.5 * np.einsum("mqxy,mqxyuv->mquv", by_S, cc)
-        mean = np.sum(w * n, axis=1) / total
-        # dC by node positions (a, i): G_aβ F_iγ + F_iβ G_aγ
-        DF = np.einsum("mquv,mqiv->mqui", D, F)
-        DtF = np.einsum("mquv,mqiu->mqvi", D, F)
-        dn_x = np.einsum("mqau,mqui->mqai", G, DF + DtF)
-        forces.append(t * mean)
-        by_x.append(t * np.einsum("mq,mqai->mai", w, dn_x) / total[:, None, None])
-        dn_X = np.einsum("mquv,mqbauv->mqba", D, dC_X)
-        by_X.append(
-            t
-            * (
-                np.einsum("mqba,mq->mba", dw, n)
-                + np.einsum("mq,mqba->mba", w, dn_X)
-                - mean[:, None, None] * dw.sum(axis=1)
-            )
-            / total[:, None, None]
-        )
+        mean, dn_x, dn_X = _chained(n, D, G, w, F, dC_X, dw, t)
+        forces.append(mean)
+        by_x.append(dn_x)
+        by_X.append(dn_X)
+    least = least_by_x = least_by_X = None
+    if with_least:  # the plain law's smaller principal force and its derivatives
+        _, S0, cc0 = problem.response(block.fibres, relaxed=False)(C, True)
+        S0 = np.broadcast_to(S0, C.shape)
+        cc0 = np.broadcast_to(cc0, (*C.shape, 2, 2))
+        m, by_C, by_S = least_force_gradients(C, S0)
+        D = by_C + 0.5 * np.einsum("mqxy,mqxyuv->mquv", by_S, cc0)
+        least, least_by_x, least_by_X = _chained(m, D, G, w, F, dC_X, dw, t)
     return BlockDerivatives(
-        mixed, np.stack(forces, axis=1), np.stack(by_x, axis=1), np.stack(by_X, axis=1)
+        mixed,
+        np.stack(forces, axis=1),
+        np.stack(by_x, axis=1),
+        np.stack(by_X, axis=1),
+        least,
+        least_by_x,
+        least_by_X,
     )
+
+
+def _chained(n, D, G, w, F, dC_X, dw, t):
+    """The cell mean ``t Σ_q w n / Σ_q w`` of a point function ``n`` ``(m, q)`` of ``C`` with
+    total derivative ``D = dn/dC`` ``(m, q, 2, 2)``, and its derivatives by the nodes' positions
+    ``(m, nen, 3)`` and by the pattern ``(m, nen, 2)`` (``dC_X``, ``dw`` of the pattern dofs)."""
+    total = w.sum(axis=1)
+    mean = np.sum(w * n, axis=1) / total
+    # dC by node positions (a, i): G_aβ F_iγ + F_iβ G_aγ
+    DF = np.einsum("mquv,mqiv->mqui", D, F)
+    DtF = np.einsum("mquv,mqiu->mqvi", D, F)
+    dn_x = np.einsum("mqau,mqui->mqai", G, DF + DtF)
+    by_x = t * np.einsum("mq,mqai->mai", w, dn_x) / total[:, None, None]
+    dn_X = np.einsum("mquv,mqbauv->mqba", D, dC_X)
+    by_X = (
+        t
+        * (
+            np.einsum("mqba,mq->mba", dw, n)
+            + np.einsum("mq,mqba->mba", w, dn_X)
+            - mean[:, None, None] * dw.sum(axis=1)
+        )
+        / total[:, None, None]
+    )
+    return t * mean, by_x, by_X
