@@ -25,6 +25,7 @@ from itertools import product
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.rigid_fit import rigid_fit
 from ..materials.anisotropic import OrthotropicStVenantKirchhoff
 from ..materials.base import MaterialError
 from ..materials.compensation_law import compensating_law
@@ -203,14 +204,6 @@ class Band:
         }
 
 
-def _aligned(reference: np.ndarray, moving: np.ndarray) -> np.ndarray:
-    """``moving`` after the proper 2D rigid motion that best fits it onto ``reference``."""
-    a, b = reference.mean(axis=0), moving.mean(axis=0)
-    u, _, vt = np.linalg.svd((moving - b).T @ (reference - a))
-    d = np.sign(np.linalg.det(u @ vt))
-    return (moving - b) @ (u @ np.diag([1.0, d]) @ vt) + a
-
-
 def check_scatter(fabric: FabricPreset, sampled: str = "compensation") -> None:
     """Raise :class:`MaterialError` for a fabric whose band of what is ``sampled`` (one of
     :data:`SAMPLED`) would be the nominal pattern alone: without measured compensation values
@@ -280,8 +273,8 @@ def pattern_band(
     dims = [pattern_dimensions(r) for r in results]
     reference = centre.material_coordinates
     deviation = max(
-        float(np.linalg.norm(_aligned(reference, r.material_coordinates) - reference, axis=1).max())
-        for r in results
+        float(np.linalg.norm(moved - reference, axis=1).max())
+        for moved in (rigid_fit(r.material_coordinates, reference) for r in results)
     )
     return PatternBand(
         mean=pattern_dimensions(centre),

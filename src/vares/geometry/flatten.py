@@ -10,7 +10,7 @@ map is the better start.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -133,13 +133,16 @@ def triangulated(mesh: SurfaceMesh) -> np.ndarray:
     return np.vstack(parts)
 
 
-def lscm(mesh: SurfaceMesh) -> np.ndarray:
+def lscm(mesh: SurfaceMesh, factorize: Callable | None = None) -> np.ndarray:
     """Least-squares conformal map (Lévy et al. 2002) of the surface, scaled to its 3D area.
 
     Minimises ``Σ_t A_t |∇v − R₉₀ ∇u|²`` (the Cauchy–Riemann residual of each triangle in its own
     plane) with two far-apart nodes pinned, by one sparse direct solve of the normal equations.
     The map keeps the cells' orientation; it is conformal, not isometric, so it is rescaled to
-    the 3D area. Returns pattern coordinates ``(n, 2)``.
+    the 3D area. Returns pattern coordinates ``(n, 2)``. ``factorize``: a function from the
+    (symmetric positive definite) normal matrix to its solver ``rhs ↦ x`` (default
+    :func:`factorized`; the solve passes its own sparse solver, PARDISO factorising the lion's
+    in a fraction of SuperLU's time, docs/benchmarks.md).
     """
     import scipy.sparse as sp
 
@@ -177,7 +180,7 @@ def lscm(mesh: SurfaceMesh) -> np.ndarray:
     rhs = -(a_free.T @ (a_pinned @ pinned_values))
     solution = np.empty(2 * n)
     solution[pinned] = pinned_values
-    solution[free] = factorized(normal_matrix)(rhs)
+    solution[free] = (factorize or factorized)(normal_matrix)(rhs)
     coordinates = solution.reshape(-1, 2)
     coordinates -= coordinates.mean(axis=0)
     flat_area = signed_area(mesh, coordinates)

@@ -30,6 +30,7 @@ from ..geometry.flatten import (
     untangle,
 )
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.rigid_fit import rigid_fit
 from ..mechanics.rigid import rigid_modes
 from ..options import OptionsError
 from .linear import IndefiniteMatrixError, LinearSolver, get_solver
@@ -89,15 +90,18 @@ def initial_guess(
     if given is not None:
         return _given(mesh, options, given)
     plane = projection_plane(mesh, options.plane)
+    solver = get_solver(options.linear_solver)
     if options.initial_guess != "auto":
-        return _make(mesh, options.initial_guess, plane)
-    start = _automatic(mesh, options, plane)
+        return _make(mesh, options.initial_guess, plane, solver=solver)
+    start = _automatic(mesh, options, plane, solver)
     if isotropic and options.strategy != "pseudo-time" and not options.named_plane:
-        return arap_refined(mesh, start, solver=get_solver(options.linear_solver))
+        return arap_refined(mesh, start, solver=solver)
     return start
 
 
-def _automatic(mesh: SurfaceMesh, options: SolveOptions, plane: ProjectionPlane) -> Start:
+def _automatic(
+    mesh: SurfaceMesh, options: SolveOptions, plane: ProjectionPlane, solver: LinearSolver
+) -> Start:
     steep = squashed_share(mesh, plane, PROJECTION_MIN_AREA_RATIO) > STEEP_SHARE
     order = ["projection", "lscm", "tutte"]
     if options.strategy == "pseudo-time":
@@ -106,7 +110,7 @@ def _automatic(mesh: SurfaceMesh, options: SolveOptions, plane: ProjectionPlane)
         order = ["lscm", "tutte"]
     folded, conformal = [], None
     for kind in order:
-        start = _make(mesh, kind, plane, conformal)
+        start = _make(mesh, kind, plane, conformal, solver)
         conformal = start.coordinates if kind == "lscm" else conformal
         inverted = inverted_cells(mesh, start.coordinates)
         if inverted.size and kind == "projection" and inverted.size <= MEND_AT_MOST:
@@ -121,7 +125,7 @@ def _automatic(mesh: SurfaceMesh, options: SolveOptions, plane: ProjectionPlane)
                 warnings.warn(f"{'; '.join(folded)}: started from {_NAMES[kind]}", stacklevel=4)
             return start
         folded.append(f"{_NAMES[kind]} folds {inverted.size} cell(s)")
-    return _make(mesh, order[0], plane)
+    return _make(mesh, order[0], plane, solver=solver)
 
 
 def arap_refined(
@@ -144,7 +148,7 @@ def arap_refined(
         x = flat.step(x)
     if inverted_cells(mesh, x).size:
         return start
-    x = _fitted(x, start.coordinates)
+    x = rigid_fit(x, start.coordinates)
     held = rigid_modes(start.coordinates, "fixed")[0]
     placed = _held_where_they_were(x, start.coordinates, held)
     if placed is not None and np.array_equal(rigid_modes(placed, "fixed")[0], held):
@@ -163,14 +167,6 @@ def _factorizer(solver: LinearSolver):
         return solver.solve
 
     return factorize
-
-
-def _fitted(x: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """``x`` moved rigidly to fit ``target`` in least squares (Kabsch, no reflection)."""
-    centre, target_centre = x.mean(axis=0), target.mean(axis=0)
-    u, _, vt = np.linalg.svd((x - centre).T @ (target - target_centre))
-    rotation = u @ np.diag([1.0, np.sign(np.linalg.det(u @ vt))]) @ vt
-    return target_centre + (x - centre) @ rotation
 
 
 def _held_where_they_were(x: np.ndarray, target: np.ndarray, held: np.ndarray) -> np.ndarray | None:
@@ -196,12 +192,20 @@ def _held_where_they_were(x: np.ndarray, target: np.ndarray, held: np.ndarray) -
     return placed
 
 
-def _make(mesh: SurfaceMesh, kind: str, plane: ProjectionPlane, conformal=None) -> Start:
-    """A start of the given kind (Tutte's reuses the ``conformal`` map when it was made)."""
+def _make(
+    mesh: SurfaceMesh,
+    kind: str,
+    plane: ProjectionPlane,
+    conformal=None,
+    solver: LinearSolver | None = None,
+) -> Start:
+    """A start of the given kind (Tutte's reuses the ``conformal`` map when it was made). The
+    conformal map's normal equations are factorised by ``solver`` (default SciPy's SuperLU);
+    Tutte's (mean-value weights: not symmetric) by SuperLU."""
     if kind == "projection":
         return Start(plane.project(mesh.points), "projection", plane)
     if kind == "lscm":
-        return Start(lscm(mesh), "lscm", None)
+        return Start(lscm(mesh, None if solver is None else _factorizer(solver)), "lscm", None)
     return Start(tutte(mesh, conformal), "tutte", None)
 
 
