@@ -489,7 +489,9 @@ def test_plot_writes_each_field_on_the_pattern_and_the_surface(tmp_path):
     from PIL import Image
 
     out = tmp_path / "out"
-    result = run("example", "cylinder160", "-o", out, "--plot", "det_F,warp_stress")
+    # a doubly curved sail: on a developable surface both fields are round-off, and how much
+    # two pictures of round-off differ depends on the round-off
+    result = run("example", "sail", "-o", out, "--plot", "det_F,warp_stress")
     assert result.exit_code == 0, result.stderr
     pictures = {}
     for field in ("det_F", "warp_stress"):

@@ -132,7 +132,10 @@ def test_inexact_newton_finds_the_same_pattern_with_one_factorisation():
     )
     residuals = [r.relative_residual for r in inexact.history]
     assert residuals[-1] <= 1e-10
-    assert residuals[-1] < 1e-2 * residuals[-2]  # superlinear at the end, not linear
+    # superlinear, not linear: the contraction itself shrinks tenfold (the last step is solved
+    # only as accurately as the tolerance asks, so it is the one before that shows the rate)
+    contractions = np.array(residuals[1:]) / np.array(residuals[:-1])
+    assert contractions[-2] < 0.1 * contractions[-3] and residuals[-2] < 1e-2 * residuals[-3]
 
 
 def _solve_with(mesh, solver, **settings):

@@ -37,6 +37,7 @@ __all__ = [
     "AssembledDofs",
     "Failure",
     "NewtonContext",
+    "absolute_hessians",
     "at_round_off",
     "describe_cells",
     "newton",
@@ -130,6 +131,11 @@ class NewtonContext:
     #: A further condition of convergence on the state (``None``: none): seam matching's seams
     #: must have equal lengths on both sides to round-off as well.
     accepts: Callable[[np.ndarray], bool] | None = None
+    #: The projected tangent of an iteration whose last step was shortened (and of the first)
+    #: has the absolute values of the exact one's eigenvalues, point by point, instead of its
+    #: negative ones set to zero (:func:`absolute_hessians`): a compressed cell's negative
+    #: curvature then stiffens the step instead of leaving it free to fold that cell.
+    absolute_after_short_steps: bool = False
 
     def __post_init__(self) -> None:
         #: the linear solver, reusing its factorisations where that is cheaper (inexact Newton)
@@ -269,6 +275,8 @@ def newton(
             and residual >= EXACT_TANGENT_BELOW * ctx.force_scale
         )
         hessians = problem.projected_hessians(evaluation) if projected else evaluation.hessians
+        if projected and ctx.absolute_after_short_steps and step_length < 1.0:
+            hessians = absolute_hessians(hessians, evaluation.hessians)
         matrix = None if converged else ctx.assembler.matrix(hessians)
         if method == "damped" and matrix is not None:
             state.cap(matrix, residual, initial_residual)
@@ -308,6 +316,19 @@ def newton(
                     ctx.squeezed.format(cells=describe_cells(search.bounded_by)), x, folding=True
                 )
     raise AssertionError("unreachable")
+
+
+def absolute_hessians(projected: list, exact: list) -> list:
+    """Per-block Hessians whose point-wise eigenvalues are the absolute values of the exact
+    ones (Chen et al. 2024), from the clamped projection: ``|H| = 2 H₊ − H`` with ``H₊`` the
+    negative eigenvalues set to zero (the nodal Hessian is linear in the point-wise one).
+    ``projected`` is overwritten. Blocks whose shapes differ, or that are the exact ones
+    themselves, are left as they are."""
+    for block, full in zip(projected, exact, strict=True):
+        if block.shape == full.shape and not np.may_share_memory(block, full):
+            block *= 2.0
+            block -= full
+    return projected
 
 
 def _ends(ctx, x, energy, converged, iteration, method, residuals) -> bool:
