@@ -11,11 +11,12 @@ compiled and loaded, memory touched); then they run ``--repeat`` times each, alt
 the median wall time of each is reported with their ratio. vares solves from scratch every
 time: from the point and cell arrays (a new ``SurfaceMesh``, its checks and cached tables
 timed), isotropic St. Venant–Kirchhoff (the hypar) or Neo-Hooke (files: on the camel head St.
-Venant–Kirchhoff does not converge in 50 + 50 iterations), E = 1000, ν = 0.3, default strategy
-and tolerance 1e-10, its sparse solver's symbolic analysis forgotten between runs. A solve
-whose Newton iteration reached the tolerance counts even where the pattern is then refused (a
-nearly closed head is no cutting pattern: its area is far from the surface's): the race is the
-cost of the optimum, and the refusal is printed. libigl runs LSCM with two pinned boundary
+Venant–Kirchhoff does not converge in 50 + 50 iterations), E = 1000, ν = 0.3, default strategy,
+start and tolerance 1e-10 (``--also-initial-guess`` races a named start beside it), its sparse
+solver's symbolic analysis forgotten between runs. A solve whose Newton iteration reached the
+tolerance counts even where the pattern is then refused (a nearly closed head is no cutting
+pattern: its area is far from the surface's): the race is the cost of the optimum, and the
+refusal is printed. libigl runs LSCM with two pinned boundary
 vertices, then ``arap_precomputation`` with one pinned vertex and 10 ARAP iterations. Peak
 memory is the process's (both methods together).
 """
@@ -43,7 +44,9 @@ def make_mesh(triangles: int):
 MATERIALS = ("stvk", "neo-hooke")
 
 
-def run_vares(mesh, solver: str | None, material: str = "stvk") -> tuple[float, dict]:
+def run_vares(
+    mesh, solver: str | None, material: str = "stvk", initial_guess: str = "auto"
+) -> tuple[float, dict]:
     import vares
     from vares.solver import linear
 
@@ -55,7 +58,10 @@ def run_vares(mesh, solver: str | None, material: str = "stvk") -> tuple[float, 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # which start was passed over is in the result
         result = vares.solve(
-            vares.SurfaceMesh(points, cells), law(1000.0, 0.3), linear_solver=solver
+            vares.SurfaceMesh(points, cells),
+            law(1000.0, 0.3),
+            linear_solver=solver,
+            initial_guess=initial_guess,
         )
     elapsed = time.perf_counter() - start
     last = result.history[-1]
@@ -94,30 +100,41 @@ def peak_mib() -> float:
     return int(status.split("VmHWM:")[1].split()[0]) / 1024
 
 
-def race(mesh, name: str, repeat: int, solver: str | None, material: str) -> float:
-    """Both methods on ``mesh``, warm, alternating; prints the medians; returns their ratio."""
-    run_vares(mesh, solver, material)  # warm-up: compiled code, loaded libraries, touched memory
+def race(
+    mesh, name: str, repeat: int, solver: str | None, material: str, also: str | None = None
+) -> float:
+    """Both methods on ``mesh``, warm, alternating; prints the medians; returns their ratio.
+    ``also``: vares is raced a second time from that start (``projection``, ``lscm``,
+    ``tutte``: a start asked for by name, never taken an ARAP step further), in the same
+    alternation, so the two starts compare side by side."""
+    variants = {"vares": "auto"} | ({f"vares ({also})": also} if also else {})
+    for guess in variants.values():  # warm-up: compiled code, loaded libraries, touched memory
+        run_vares(mesh, solver, material, guess)
     run_arap(mesh)
-    times: dict[str, list[float]] = {"vares": [], "arap": []}
-    info = {}
+    times: dict[str, list[float]] = {name: [] for name in variants} | {"arap": []}
+    info: dict[str, dict] = {}
     for _ in range(repeat):
-        elapsed, info = run_vares(mesh, solver, material)
-        times["vares"].append(elapsed)
+        for variant, guess in variants.items():
+            elapsed, info[variant] = run_vares(mesh, solver, material, guess)
+            times[variant].append(elapsed)
         times["arap"].append(run_arap(mesh)[0])
     median = {k: statistics.median(v) for k, v in times.items()}
     print(f"{name}, {mesh.num_cells} triangles:")
     for method, values in times.items():
         shown = ", ".join(f"{v:.3f}" for v in values)
-        print(f"  {method:<6} median {median[method]:.3f} s  (runs: {shown})")
-    ratio = median["vares"] / median["arap"]
-    print(
-        f"  vares / (LSCM + ARAP) = {ratio:.2f}; vares: from {info['start']}, "
-        f"{info['iterations']} Newton iterations, {info['solver']} ({info['factorisations']} "
-        f"factorisations, {info['cg']} CG iterations), energy {info['energy']:.12g}"
-    )
-    if info["refused"]:
-        print(f"  (the optimum reached, then refused as a pattern: {info['refused']})")
-    return ratio
+        print(f"  {method:<18} median {median[method]:.3f} s  (runs: {shown})")
+    for variant in variants:
+        ratio = median[variant] / median["arap"]
+        found = info[variant]
+        print(
+            f"  {variant} / (LSCM + ARAP) = {ratio:.2f}; from {found['start']}, "
+            f"{found['iterations']} Newton iterations, {found['solver']} "
+            f"({found['factorisations']} factorisations, {found['cg']} CG iterations), "
+            f"energy {found['energy']:.12g}"
+        )
+        if found["refused"]:
+            print(f"  (the optimum reached, then refused as a pattern: {found['refused']})")
+    return median["vares"] / median["arap"]
 
 
 def main() -> None:
@@ -128,6 +145,11 @@ def main() -> None:
     parser.add_argument("--solver", default=None, help="vares linear solver (default: fastest)")
     parser.add_argument(
         "--material", choices=MATERIALS, help="default: stvk (hypar), neo-hooke (files)"
+    )
+    parser.add_argument(
+        "--also-initial-guess",
+        choices=("projection", "lscm", "tutte"),
+        help="race vares from this start too (never ARAP-refined), side by side",
     )
     args = parser.parse_args()
     import vares
@@ -147,15 +169,19 @@ def main() -> None:
                 args.repeat,
                 args.solver,
                 args.material or "neo-hooke",
+                args.also_initial_guess,
             )
     else:
         mesh = make_mesh(args.triangles)
-        race(mesh, "hypar", args.repeat, args.solver, args.material or "stvk")
+        material = args.material or "stvk"
+        race(mesh, "hypar", args.repeat, args.solver, material, args.also_initial_guess)
     print(f"peak {peak_mib():.0f} MiB")
     source = " ".join(f"--file {path}" for path in args.file) or f"--triangles {args.triangles}"
     command = f"python benchmarks/race.py {source} --repeat {args.repeat}"
     command += f" --solver {args.solver}" if args.solver else ""
-    print(f"reproduce: {command}" + (f" --material {args.material}" if args.material else ""))
+    command += f" --material {args.material}" if args.material else ""
+    also = args.also_initial_guess
+    print(f"reproduce: {command}" + (f" --also-initial-guess {also}" if also else ""))
 
 
 if __name__ == "__main__":
