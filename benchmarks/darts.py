@@ -13,20 +13,28 @@ Moulds: ``hemisphere`` (``irregular_cap(100, 90, rings, 0.3, 1)``, R = 100 mm to
 ``double_dome(cell_size=c)`` for every ``--cell-size c``, warp along x; its kinematic drape at
 spacing 2 mm from the saddle's centre, the node nearest it and points beside it is printed
 first, ``--kinematic``: only that); laws: ``ncf`` (the README's non-crimp fabric,
-``NonCrimpFabric([-250, 250], [-250, 250], [0.5])``) and ``woven`` (orthotropic, E/G = 1e4).
+``NonCrimpFabric([-250, 250], [-250, 250], [0.5])``), ``ncf-stiffening`` (the same with a shear
+term ``C₆/6 (I8²/(I4 I6))⁶ = C₆/6 sin¹²γ``, ``C₆ = 200``, that stiffens towards 50°: 28 times
+the plain law's shear stiffness there, 0.4 times at 30°; an illustrative choice, not a fitted
+fabric) and ``woven`` (orthotropic, E/G = 1e4). On the double dome every solve also prints the
+largest shear per quadrant and the yarn strains (the area share beyond 1, 2 and 5 %, and the
+largest).
 
     python benchmarks/darts.py --rings 20 30 40 --control --picture docs/images
     python benchmarks/darts.py --mould rib30 --locking 50 4
     python benchmarks/darts.py --mould double-dome --cell-size 5 4 --law ncf woven
     python benchmarks/darts.py --mould double-dome --radial 35 --law ncf woven
     python benchmarks/darts.py --rings 30 --turned 0 15 30 45 --length 35
+    python benchmarks/darts.py --mould double-dome --mirrored 40 30 --law ncf ncf-stiffening
 
 (``--radial``: on the double dome, four given darts along the rays from the domes' centres
 ``(±55, 0)`` at ``±--ray-angle`` (default 36.9°, towards the most sheared cells) to the x-axis,
 from the flange's edge to these plan distances (mm) from the centre. ``--turned``: on the
 hemisphere, four given darts of ``--length`` mm from the equator at the 45° meridians, each a
 great circle turned by these angles from the meridian, the same way round at every dart,
-instead of the automatic ones.)
+instead of the automatic ones. ``--mirrored``: on the double dome, the first automatic dart of
+the pattern without darts of the plain ``ncf`` law at these tip angles, mirrored across both
+planes of symmetry: a symmetric set of four, opened on every ``--law``.)
 """
 
 from __future__ import annotations
@@ -46,6 +54,9 @@ from vares.materials import NonCrimpFabric, OrthotropicStVenantKirchhoff
 
 LAWS = {
     "ncf": lambda: NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5]),
+    "ncf-stiffening": lambda: NonCrimpFabric(
+        [-250.0, 250.0], [-250.0, 250.0], [0.5, 0.0, 0.0, 0.0, 0.0, 200.0]
+    ),
     "woven": lambda: OrthotropicStVenantKirchhoff(E1=1e4, E2=1e4, G12=1.0, nu12=0.0),
 }
 
@@ -62,7 +73,8 @@ def mould(name: str, rings: int, cell_size: float = 5.0):
 def kinematic(mesh, warp, locking: float) -> None:
     """The kinematic drape from the saddle's centre (on both planes of symmetry): its largest
     shear, the area at or beyond the locking angle and the share of the area the net reaches;
-    then from the node nearest it, and from points 0.01 and 0.1 mm beside it."""
+    then from the node nearest it, and from points 0.01 and 0.1 mm beside it (0.1 mm: across
+    the sides of the face the centre lies in)."""
     centre = np.array([0.0, 0.0, float(double_dome_height(np.zeros(1), np.zeros(1))[0])])
     points = mesh.points
     node = points[np.argmin(np.hypot(points[:, 0], points[:, 1]))]
@@ -72,6 +84,10 @@ def kinematic(mesh, warp, locking: float) -> None:
         centre + np.array([0.01, 0.0, 0.0]),
         centre + np.array([0.0, 0.01, 0.0]),
         centre + np.array([0.1, 0.1, 0.0]),
+        centre + np.array([0.1, 0.0, 0.0]),
+        centre + np.array([-0.1, 0.0, 0.0]),
+        centre + np.array([0.0, 0.1, 0.0]),
+        centre + np.array([0.0, -0.1, 0.0]),
     ):
         kinematic_from(mesh, seed, warp, locking)
 
@@ -106,7 +122,12 @@ def main() -> None:
     parser.add_argument("--length", type=float, default=35.0, help="their length (mm)")
     parser.add_argument("--radial", type=float, nargs="+", help="given darts' ends (mm)")
     parser.add_argument("--ray-angle", type=float, default=36.9, help="their rays (degrees)")
+    parser.add_argument("--mirrored", type=float, nargs="+", help="tip angles (degrees)")
     args = parser.parse_args()
+    if args.mirrored:
+        for size in args.cell_size:
+            mirrored(size, args.law, args.locking[0], args.mirrored)
+        return
     if args.radial:
         for size in args.cell_size:
             for law in args.law:
@@ -222,6 +243,28 @@ def radial(cell_size: float, law: str, locking: float, end: float, angle: float)
     quadrants(darted)
 
 
+def mirrored(cell_size: float, laws: list[str], locking: float, tips: list[float]) -> None:
+    """Symmetric darts on the double dome: the first automatic dart of the plain ``ncf``
+    pattern at each tip angle, mirrored across x = 0 and y = 0 (module docs)."""
+    from vares import solve
+    from vares.analysis.darts import erected_yarns, place_darts
+
+    mesh, warp = mould("double-dome", 0, cell_size)
+    plain = solve(mesh, LAWS["ncf"](), warp_direction=warp)
+    fibres = plain.fibres
+    yarns = erected_yarns(mesh, plain.material_coordinates, fibres.warp, fibres.fill)
+    for tip in tips:
+        first = place_darts(mesh, plain.fields["shear_angle"], *yarns, locking, tip)[0].points
+        lines = [first * np.array([sx, sy, 1.0]) for sx in (1.0, -1.0) for sy in (1.0, -1.0)]
+        for law in laws:
+            darted, text = given(mesh, law, locking, lines, warp)
+            print(
+                f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, the ncf pattern's "
+                f"first dart at tip {tip:g}° mirrored into four: {text}"
+            )
+            quadrants(darted)
+
+
 def given(mesh, law: str, locking: float, lines: list[np.ndarray], warp):
     """The pattern with the given dart ``lines`` open, and the line printed of it: the largest
     shear before and after, the solve's iterations, the darts' lengths and mouth openings."""
@@ -243,7 +286,8 @@ def given(mesh, law: str, locking: float, lines: list[np.ndarray], warp):
 
 
 def quadrants(darted) -> None:
-    """The largest shear of every quadrant (signs of x and y) before and after the darts."""
+    """The largest shear of every quadrant (signs of x and y) before and after the darts, and
+    the yarn strains: the area share beyond 1, 2 and 5 % and the largest."""
     for name, result in (("before", darted.before), ("after", darted.after)):
         if result is None:
             continue
@@ -253,9 +297,18 @@ def quadrants(darted) -> None:
             shear[(np.sign(centres[:, 0]) == sx) & (np.sign(centres[:, 1]) == sy)].max()
             for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))
         ]
+        fields = result.fields
+        strain = np.maximum(
+            np.abs(fields["warp_stretch"] - 1.0), np.abs(fields["fill_stretch"] - 1.0)
+        )
+        areas = result.mesh.cell_areas()
+        shares = [100 * areas[strain > limit].sum() / areas.sum() for limit in (0.01, 0.02, 0.05)]
         print(
             f"  {name}: largest shear per quadrant (+,+) (-,+) (-,-) (+,-): "
             + ", ".join(f"{v:.2f}°" for v in largest)
+            + "; yarn strain beyond 1, 2, 5 %: "
+            + ", ".join(f"{v:.2f} %" for v in shares)
+            + f" of the area, largest {100 * strain.max():.2f} %"
         )
 
 
