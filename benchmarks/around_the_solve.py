@@ -1,30 +1,34 @@
 """What a `vares pattern` command costs around its solve: reading, checking, files, previews
-and the report, for a small roof, a 20k-triangle scan and a 100k-triangle hypar.
+and the report, for a 512-triangle sail, a small roof, a 20k-triangle scan and a 100k-triangle
+hypar.
 
-    python benchmarks/around_the_solve.py [--repeat 5] [--sizes sail small scan large]
+    python benchmarks/around_the_solve.py [--repeat 5] [--sizes sail small scan large] [--first]
     python benchmarks/around_the_solve.py --breakdown [--repeat 5] [--sizes sail]
 
 Every run is a fresh `vares pattern FILE -o DIR --force` process (compiled kernels cached on
 disk, as after the first run of an install), in three variants: `--no-previews`, the default
-(SVG and PNG previews) and `--report`. Prints the median wall time of the whole process, the
-solve's own time (``elapsed_seconds`` + ``warm_up_seconds`` of summary.json) and what the
-report adds; and, first, what merely loading the libraries a run uses costs: a script that
-imports them and calls one compiled (cached) numba function, the floor under any command.
-The command is the ``vares`` script installed beside this Python (a version manager's shim on
-PATH, such as pyenv's, adds its own start-up: 0.08 s here), else the one on PATH; it imports
-the package from PYTHONPATH first: ``PYTHONPATH=src`` measures this tree's code.
+(SVG and PNG previews) and `--report`. Prints the median wall time of the whole process, its
+CPU seconds (user + system, as the operating system counts them: the steadier figure on a
+machine shared with other work), the solve's own time (``elapsed_seconds`` +
+``warm_up_seconds`` of summary.json) and what the report adds; and, first, what merely loading
+the libraries a run may use costs: a script that imports them and calls one compiled (cached)
+numba function. ``--first``: also the first run after an install, numba's cache of compiled
+kernels empty (``NUMBA_CACHE_DIR`` a new folder each run). The command is the ``vares``
+script installed beside this Python (a version manager's shim on PATH, such as pyenv's, adds
+its own start-up: 0.08 s here), else the one on PATH; it imports the package from PYTHONPATH
+first: ``PYTHONPATH=src`` measures this tree's code.
 
 Python's compiled byte code is written and used as on any install (``PYTHONDONTWRITEBYTECODE``
 removed from the commands' environment, the byte code kept in a folder of the benchmark's own,
 ``PYTHONPYCACHEPREFIX``); with ``--no-bytecode`` every module is compiled from source at every
 start, as where that variable is set (some containers): compare the two.
 
-``--breakdown``: where the time of a default run goes, phase by phase, medians over fresh
-processes: starting Python, importing the command line, reading and checking the mesh, loading
-the solver's compiled kernels, the solve, each output file (the first file to need a library
-imports it: the DXF's time includes ezdxf's import), and the rest (the job file, moving the
-staging folder into place, exiting); then the libraries' import times (``-X importtime``,
-summed per top-level package).
+``--breakdown``: where the time of a default run goes, phase by phase, wall and CPU seconds,
+medians over fresh processes: starting Python, importing the command line, reading and checking
+the mesh, loading the solver's compiled kernels, the solve, each output file (the first file to
+need a library imports it: the DXF's time includes ezdxf's import), and the rest (arguments,
+options, the job file, moving the staging folder into place, exiting); then the libraries'
+import times (``-X importtime``, summed per top-level package).
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -70,13 +75,24 @@ def set_bytecode(write: bool, folder: Path) -> None:
         ENVIRONMENT["PYTHONDONTWRITEBYTECODE"] = "1"
 
 
-def run(path: Path, out: Path, flags: list[str]) -> tuple[float, float]:
+def run(path: Path, out: Path, flags: list[str]) -> tuple[float, float, float]:
+    """Wall and CPU seconds of one `vares pattern` process, and its solve's own seconds."""
     command = [vares_script(), "pattern", str(path), "-o", str(out), "--force", "-q", *flags]
-    start = time.perf_counter()
-    subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)
-    wall = time.perf_counter() - start
+    wall, cpu, _ = timed_run(command)
     summary = json.loads((out / "summary.json").read_text())
-    return wall, summary["elapsed_seconds"] + summary.get("warm_up_seconds", 0.0)
+    return wall, cpu, summary["elapsed_seconds"] + summary.get("warm_up_seconds", 0.0)
+
+
+def first_run(path: Path, folder: Path) -> tuple[float, float]:
+    """Wall and CPU seconds of a default run as the first after an install: numba's cache of
+    compiled kernels empty (``NUMBA_CACHE_DIR`` a new folder), Python's byte code written."""
+    cache = Path(tempfile.mkdtemp(dir=folder))
+    ENVIRONMENT["NUMBA_CACHE_DIR"] = str(cache)
+    try:
+        command = [vares_script(), "pattern", str(path), "-o", str(cache / "out"), "-q"]
+        return timed_run(command)[:2]
+    finally:
+        del ENVIRONMENT["NUMBA_CACHE_DIR"]
 
 
 #: What a `vares pattern` run loads, without vares: the floor of its time.
@@ -92,39 +108,41 @@ first(np.ones(3))
 """
 
 
-def libraries_alone(folder: Path, repeat: int) -> float:
+def libraries_alone(folder: Path, repeat: int) -> tuple[float, float]:
     script = folder / "libraries.py"
     script.write_text(LIBRARIES)
     subprocess.run([sys.executable, str(script)], check=True, env=ENVIRONMENT)  # compiles once
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        subprocess.run([sys.executable, str(script)], check=True, env=ENVIRONMENT)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
+    runs = [timed_run([sys.executable, str(script)])[:2] for _ in range(repeat)]
+    return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
 
 
 #: A default `vares pattern` run in a fresh process with each phase timed (the command line's
-#: own functions wrapped, nothing else changed); prints the phases as JSON.
+#: own functions wrapped, nothing else changed); prints the phases' wall and CPU seconds as JSON.
 BREAKDOWN = """\
 import json, os, sys, time
-started = time.perf_counter()
+clocks = lambda: (time.perf_counter(), time.process_time())
+started = clocks()
 from vares.app.cli import main
-imported = time.perf_counter()
+import vares.app.cli.pattern  # the subcommand's module, as main() imports it
+imported = clocks()
 from vares.app import outputs, runner
+from vares.solver import api
 phases = {}
 
 def timed(name, function):
     def call(*args, **kwargs):
-        start = time.perf_counter()
+        start = clocks()
         try:
             return function(*args, **kwargs)
         finally:
-            phases[name] = phases.get(name, 0.0) + time.perf_counter() - start
+            wall, cpu = phases.get(name, (0.0, 0.0))
+            end = clocks()
+            phases[name] = (wall + end[0] - start[0], cpu + end[1] - start[1])
     return call
 
 runner.load_input = timed("read", runner.load_input)
 runner._solve = timed("solve", runner._solve)
+api._load_kernels = timed("loading the kernels", api._load_kernels)
 runner.write_job_file = timed("job.toml", runner.write_job_file)
 write = outputs._write
 outputs._write = lambda panel, name, writer: timed(name, write)(panel, name, writer)
@@ -135,54 +153,69 @@ try:
     main()
 except SystemExit:
     pass
-phases["import"] = imported - started
-phases["command"] = time.perf_counter() - started
+phases["import"] = (imported[0] - started[0], imported[1] - started[1])
+done = clocks()
+phases["command"] = (done[0] - started[0], done[1] - started[1])
 print(json.dumps(phases), flush=True)
 end(0)
 """
 
 
+def timed_run(command: list[str]) -> tuple[float, float, subprocess.CompletedProcess]:
+    """Wall and CPU seconds (user + system, the operating system's own count) of a fresh
+    process, and what it printed."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    done = subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+    return wall, cpu, done
+
+
 def breakdown(path: Path, folder: Path, repeat: int) -> None:
-    """The phases of a default run, medians of ``repeat`` fresh processes."""
+    """The phases of a default run, wall and CPU seconds, medians of ``repeat`` fresh
+    processes (on a loaded machine the CPU seconds are the steadier figure)."""
     script = folder / "breakdown.py"
     script.write_text(BREAKDOWN)
     out = folder / "breakdown"
     command = [sys.executable, str(script), str(path), "-o", str(out), "--force", "-q"]
     subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)  # warm
     python = [sys.executable, "-c", "pass"]
-    rows: list[dict[str, float]] = []
+    rows: list[dict[str, tuple[float, float]]] = []
     for _ in range(repeat):
-        start = time.perf_counter()
-        subprocess.run(python, check=True, env=ENVIRONMENT)
-        alone = time.perf_counter() - start
-        start = time.perf_counter()
-        done = subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)
-        whole = time.perf_counter() - start
-        phases = json.loads(done.stdout.decode().strip().splitlines()[-1])
-        summary = json.loads((out / "summary.json").read_text())
-        kernels = summary.get("warm_up_seconds", 0.0)
+        alone = timed_run(python)[:2]
+        wall, cpu, done = timed_run(command)
+        phases = {k: tuple(v) for k, v in json.loads(done.stdout.decode().splitlines()[-1]).items()}
+        kernels = phases.get("loading the kernels", (0.0, 0.0))
         phases["loading the kernels"] = kernels
-        phases["solve"] -= kernels
+        phases["solve"] = (phases["solve"][0] - kernels[0], phases["solve"][1] - kernels[1])
         phases["starting Python"] = alone
-        phases["whole process"] = whole
+        phases["whole process"] = (wall, cpu)
         timed = [k for k in phases if k not in ("command", "whole process", "starting Python")]
-        phases["the rest"] = phases["command"] - sum(phases[k] for k in timed)
-        phases["exit"] = whole - alone - phases["command"]
+        phases["the rest"] = tuple(
+            phases["command"][i] - sum(phases[k][i] for k in timed) for i in range(2)
+        )
+        phases["exit"] = tuple(
+            phases["whole process"][i] - alone[i] - phases["command"][i] for i in range(2)
+        )
         rows.append(phases)
-    order = ["whole process", "starting Python", "import", "read", "loading the kernels", "solve"]
+    order = ["whole process", "starting Python", "import", "read", "loading the kernels"]
+    order += ["solve"]
     order += [k for k in rows[0] if k not in {*order, "command", "the rest", "exit"}]
     order += ["the rest", "exit"]
     names = {
         "import": "importing the command line",
         "read": "reading and checking the mesh",
         "the rest": "the rest of the command (arguments, options, checks, staging folder)",
-        "exit": "ending the process, and what the clock saw outside the command",
+        "exit": "ending the process, and what the clocks saw outside the command",
     }
-    print("| phase | s |")
-    print("|---|---|")
+    print("| phase | wall s | CPU s |")
+    print("|---|---|---|")
     for key in order:
-        value = statistics.median(r[key] for r in rows)
-        print(f"| {names.get(key, key)} | {value:.3f} |")
+        wall = statistics.median(r[key][0] for r in rows)
+        cpu = statistics.median(r[key][1] for r in rows)
+        print(f"| {names.get(key, key)} | {wall:.3f} | {cpu:.3f} |")
     importtime(command, repeat)
 
 
@@ -221,10 +254,15 @@ def main() -> None:
     parser.add_argument("--sizes", nargs="+", default=None, choices=list(SIZES))
     parser.add_argument("--breakdown", action="store_true", help="phase by phase, one size")
     parser.add_argument("--no-bytecode", action="store_true", help="compile every module anew")
+    parser.add_argument(
+        "--first", action="store_true", help="also the first run after an install (no numba cache)"
+    )
     args = parser.parse_args()
     sizes = args.sizes or (["sail"] if args.breakdown else list(SIZES))
-    flags = (" --breakdown" if args.breakdown else "") + (
-        " --no-bytecode" if args.no_bytecode else ""
+    flags = "".join(
+        f" --{name.replace('_', '-')}"
+        for name in ("breakdown", "no_bytecode", "first")
+        if getattr(args, name)
     )
     print(f"# python benchmarks/around_the_solve.py --repeat {args.repeat} --sizes "
           f"{' '.join(sizes)}{flags}")  # fmt: skip
@@ -239,29 +277,34 @@ def main() -> None:
             print(f"{label}, default outputs")
             breakdown(path, folder, args.repeat)
         return
-    print("| surface | variant | whole command s | solve s | rest s |")
-    print("|---|---|---|---|---|")
+    print("| surface | variant | whole command s | CPU s | solve s | rest s |")
+    print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
         set_bytecode(not args.no_bytecode, folder)
-        floor = libraries_alone(folder, args.repeat)
-        print(f"| (no surface) | the libraries alone | {floor:.2f} | | |")
+        wall, cpu = libraries_alone(folder, args.repeat)
+        print(f"| (no surface) | the libraries alone | {wall:.2f} | {cpu:.2f} | | |")
         for size in sizes:
             label, make = SIZES[size]
             mesh = make()
             path = folder / f"{size}.obj"
             meshio.write(path, meshio.Mesh(mesh.points, list(mesh.cells.items())))
-            run(path, folder / "warm", [])  # compiles on a fresh install, loads afterwards
+            run(path, folder / "warm", [])  # byte code written, kernels compiled or loaded
+            if args.first:
+                runs = [first_run(path, folder) for _ in range(args.repeat)]
+                wall = statistics.median(r[0] for r in runs)
+                cpu = statistics.median(r[1] for r in runs)
+                print(f"| {label} | first run after install | {wall:.2f} | {cpu:.2f} | | |")
             medians = {}
             for variant, flags in VARIANTS.items():
                 runs = [run(path, folder / size, flags) for _ in range(args.repeat)]
-                wall = statistics.median(r[0] for r in runs)
-                solve = statistics.median(r[1] for r in runs)
+                wall, cpu, solve = (statistics.median(r[k] for r in runs) for k in range(3))
                 medians[variant] = wall
-                print(f"| {label} | {variant} | {wall:.2f} | {solve:.2f} | {wall - solve:.2f} |")
+                print(f"| {label} | {variant} | {wall:.2f} | {cpu:.2f} | {solve:.2f} | "
+                      f"{wall - solve:.2f} |")  # fmt: skip
                 sys.stdout.flush()
             report = medians["--report"] - medians["default"]
-            print(f"| {label} | report adds | {report:.2f} | | |")
+            print(f"| {label} | report adds | {report:.2f} | | | |")
 
 
 if __name__ == "__main__":
