@@ -11,7 +11,7 @@ import vares
 from vares.geometry.cross_cut import cut_across
 from vares.geometry.examples import cylinder160, saddle, tent_roof
 from vares.geometry.flatten import lscm
-from vares.geometry.surface_lines import SurfaceLine, geodesic_lines, triangulated
+from vares.geometry.surface_lines import CuttingError, SurfaceLine, geodesic_lines, triangulated
 from vares.structures import find_seams, split_panels
 from vares.structures.cutting import cut
 from vares.structures.layout import plan_strips
@@ -221,3 +221,16 @@ def test_the_conic_tent_uses_four_fifths_of_the_roll(roll):
         assert second == first + 1 == len(result.plan.panels) - 1
         names = [result.plan.panels[k].name for k in result.plan.split]
         assert names == [f"strip-{first + 1}a", f"strip-{first + 1}b"]
+
+
+@pytest.mark.parametrize(
+    ("interlock", "strips"), [(False, "strips of 0.001"), (True, "strips in pairs 0.001 wide")]
+)
+def test_a_refusal_says_what_the_strips_are_planned_as(interlock, strips):
+    """In pairs two strips share the roll's width, each about half of it: the refusal of a
+    roll too narrow for the surface's refinement says so, not that the strips are as wide as
+    the roll."""
+    mesh = saddle(size=8.0, height=1.6, n=6)
+    with pytest.raises(CuttingError) as info:
+        plan_strips(mesh, 1e-3, interlock=interlock, max_strips=10**9)
+    assert str(info.value).startswith(f"{strips} would need the surface refined to about")

@@ -107,8 +107,13 @@ class CutResult:
             notes.append(
                 f"the surface was refined on its own faces ({plan.refinements} {rounds} of "
                 f"midpoint subdivision, {plan.input_cells:,} → {plan.refined_cells:,} triangles) "
-                f"so that every strip is at least {CELLS_ACROSS} cells across; its shape and "
-                "area are unchanged"
+                f"so that a strip as wide as the roll is at least {CELLS_ACROSS} cells across"
+                + (
+                    " (a strip of a pair, about half as wide, about half as many)"
+                    if plan.interlock
+                    else ""
+                )
+                + "; its shape and area are unchanged"
             )
         if plan.replaced_geodesics:
             notes.append(

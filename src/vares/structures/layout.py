@@ -107,14 +107,16 @@ def plan_strips(
         estimate = sum(strip_widths(whole, family, seam_allowance, edge_allowance)) / width
         if estimate > max_strips:
             raise CuttingError(f"more than {max_strips} strips would be needed")
+    # in pairs two strips share the width, each about half of it
+    strips = f"strips in pairs {width:g} wide" if interlock else f"strips of {width:g}"
     cells = refined_cells(surface, width / CELLS_ACROSS)
     if cells > MAX_REFINED_CELLS:
         raise CuttingError(
-            f"strips of {width:g} would need the surface refined to about {cells:,.0f} cells "
+            f"{strips} would need the surface refined to about {cells:,.0f} cells "
             f"(edges of at most {width / CELLS_ACROSS:g}; at most {MAX_REFINED_CELLS:,}): try a "
             "wider roll"
         )
-    refined = _Refined(surface, width)
+    refined = _Refined(surface, width, strips)
 
     def evaluate(spans: np.ndarray) -> tuple[StripPlan, np.ndarray]:
         plan = refined.layout(family, spans, seams, snap, warp_direction)
@@ -157,7 +159,10 @@ def plan_strips(
             count = max(count + 1, math.ceil(count * max(plan.widths) / width))
     best = min((c for c, p in tried.items() if max(p.widths) <= width), default=None)
     if best is None:
-        raise CuttingError(f"no layout of up to {max(tried)} strips fits the roll width {width:g}")
+        fit = "two side by side, each about half of it" if interlock else "one"
+        raise CuttingError(
+            f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
+        )
     plan = tried[best]
     plan.evaluations, plan.history = evaluations, history
     return plan
@@ -179,8 +184,8 @@ class _Refined:
     times at most for the whole plan) when planned lines meet; then plane sections in place of
     geodesics where they still do."""
 
-    def __init__(self, surface: SurfaceMesh, width: float) -> None:
-        self.width, self.longest = width, width / CELLS_ACROSS
+    def __init__(self, surface: SurfaceMesh, width: float, strips: str) -> None:
+        self.width, self.longest, self.strips = width, width / CELLS_ACROSS, strips
         self.surface, self.rounds = refine(surface, self.longest)
         self.retries = _RETRIES
 
@@ -200,7 +205,7 @@ class _Refined:
             plan = _layout(self.surface, family, spans, "planar", snap, warp_direction, self.width)
         except LinesMeetError as exc:
             raise CuttingError(
-                f"the cutting lines for strips of {self.width:g} meet even on the surface refined "
+                f"the cutting lines for {self.strips} meet even on the surface refined "
                 f"{self.rounds} times ({exc}): try a wider roll, another layout or strip direction"
             ) from None
         plan.replaced_geodesics = len(plan.lines) if seams == "geodesic" else 0
