@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._jit import compiled, njit
+from ..._jit import compiled, lanes, njit
 
 
 def determinant(a: np.ndarray) -> np.ndarray:
@@ -53,10 +53,15 @@ class ReferenceElement:
     def jacobians(self, coordinates: np.ndarray, cells: np.ndarray, at: str = "quadrature"):
         """``∂x/∂ξ`` of every cell, ``(m, q, d, 2)`` for node coordinates ``(n, d)``."""
         grads = self.shape_gradients if at == "quadrature" else self.check_gradients
-        if coordinates.dtype != np.float64 or not compiled(len(cells)):
-            # complex-step checks and small meshes take the general path
+        if coordinates.dtype != np.float64:  # complex-step checks take the general path
             return np.swapaxes(coordinates[cells], 1, 2)[:, None] @ grads
-        return _jacobians(np.ascontiguousarray(coordinates), np.ascontiguousarray(cells), grads)
+        coordinates, cells = np.ascontiguousarray(coordinates), np.ascontiguousarray(cells)
+        out = np.zeros((len(cells), grads.shape[0], coordinates.shape[1], 2))
+        if compiled(len(cells)):
+            _jacobians(coordinates, cells, grads, out)
+        else:  # the same loop over all cells at once, the same sums (vares._jit)
+            _jacobians.py_func(coordinates, lanes(cells), grads, lanes(out))
+        return out
 
     def metrics(self, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """Surface metric ``jᵀj`` at the quadrature points, ``(m, q, 2, 2)``."""
@@ -82,11 +87,11 @@ class ReferenceElement:
 
 
 @njit(cache=True)
-def _jacobians(coordinates, cells, grads):  # pragma: no cover - compiled
-    """``∂x/∂ξ`` ``(m, q, d, 2)`` of cells ``(m, nen)`` for node coordinates ``(n, d)``."""
-    m, nen = cells.shape
+def _jacobians(coordinates, cells, grads, out):  # pragma: no cover - compiled
+    """Add ``∂x/∂ξ`` ``(m, q, d, 2)`` of cells ``(m, nen)`` for node coordinates ``(n, d)``
+    into ``out``."""
+    m, nen = cells.shape[0], cells.shape[1]
     nq, d = grads.shape[0], coordinates.shape[1]
-    out = np.zeros((m, nq, d, 2))
     for e in range(m):
         for q in range(nq):
             for a in range(nen):
@@ -96,4 +101,3 @@ def _jacobians(coordinates, cells, grads):  # pragma: no cover - compiled
                     x = coordinates[node, i]
                     out[e, q, i, 0] += x * g0
                     out[e, q, i, 1] += x * g1
-    return out
