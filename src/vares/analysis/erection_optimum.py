@@ -45,20 +45,19 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..materials import Hyperelastic
-from ..mechanics.problem import Problem
 from ..options import split_settings, takes_options
 from ..solver.linear import quiet_blas
 from ..solver.options import SolveOptions
-from ..solver.result import PatternResult
-from .erection import ErectionResult, erect
+from .erection import erect
 from .erection_model import Pattern, patterns_of
+from .erection_optimum_result import OptimisedPatterns, OptimumRecord, optimised_results
 from .erection_residuals import (
     PatternLayout,
     ResidualModel,
@@ -95,78 +94,6 @@ LSQR_LIMIT = 15
 #: RMS force deviation of 1e-9 of it still leaves each cell's within a few 1e-9).
 FORCE_FLOOR = 1e-9
 SHAPE_FLOOR = 1e-11
-
-
-@dataclass(frozen=True)
-class OptimumRecord:
-    """One iteration: the objective ``J`` and its force and shape parts, the erected RMS force
-    deviation, the largest and RMS shape deviation, the largest seam mismatch (length units),
-    the damping ``μ``, LSQR's iterations, whether the step was taken, the Newton iterations
-    of its trial erection, the gain ratio (the decrease of ``J`` against the Gauss–Newton
-    model's) and the step's largest edge strain."""
-
-    iteration: int
-    objective: float
-    force_part: float
-    shape_part: float
-    force_rms: float
-    deviation_max: float
-    deviation_rms: float
-    seam_mismatch: float
-    damping: float
-    lsqr_iterations: int
-    accepted: bool
-    erection_iterations: int = 0
-    gain: float = 0.0
-    step_strain: float = 0.0
-
-
-@dataclass
-class OptimisedPatterns:
-    """The optimised patterns (one :class:`Pattern` per panel, as given), the erections of the
-    starting and of the optimised patterns, the iterations and why it stopped."""
-
-    patterns: list[Pattern]
-    start: ErectionResult
-    erected: ErectionResult
-    history: list[OptimumRecord]
-    converged: bool
-    reason: str | None
-    shape_weight: float
-    shape_bound: float | None = None
-    elapsed: float = 0.0
-
-    @property
-    def iterations(self) -> int:
-        return sum(1 for r in self.history if r.iteration > 0)
-
-    def to_dict(self) -> dict[str, object]:
-        """What ``erect.json`` holds under ``optimisation``: the optimiser's settings and
-        iterations, and the erected figures of the starting (VaReS) patterns beside which the
-        file's own figures are those of the optimised ones."""
-        return {
-            "converged": self.converged,
-            "reason": self.reason,
-            "iterations": self.iterations,
-            "shape_weight": self.shape_weight,
-            "shape_bound": self.shape_bound,
-            "elapsed_seconds": self.elapsed,
-            "start_erected": {
-                "deviation": self.start.deviation(),
-                **self.start.statistics(),
-            },
-            "history": [
-                {
-                    "iteration": r.iteration,
-                    "objective": r.objective,
-                    "force_rms": r.force_rms,
-                    "deviation_max": r.deviation_max,
-                    "seam_mismatch": r.seam_mismatch,
-                    "accepted": r.accepted,
-                }
-                for r in self.history
-            ],
-        }
 
 
 def _erect(patterns, material, thickness, solver, options, start, primer=None):
@@ -393,7 +320,8 @@ def _trial_erection(trial, material, thickness, solver, options, erected, model,
     iterations, or ``(None, n)`` where a pattern cell turned over or the erection did not
     converge."""
     newton = 0
-    for start in (predicted_positions(erected, dx), erected.erected_points):
+    predicted = predicted_positions(erected.erected_points, erected.context.assembler.free, dx)
+    for start in (predicted, erected.erected_points):
         try:
             attempt = _erect(
                 trial, material, thickness, solver, options, start, model.tangent_solve
@@ -449,29 +377,3 @@ def _record(
         accepted,
         newton,
     )
-
-
-def optimised_results(
-    results: list[PatternResult], optimum: OptimisedPatterns
-) -> list[PatternResult]:
-    """The solves' results with the optimised patterns in place of theirs (energy on the design
-    shape and per-cell fields of the new patterns; the rest, history included, as solved)."""
-    out = []
-    for result, pattern in zip(results, optimum.patterns, strict=True):
-        coordinates = np.asarray(pattern.material_coordinates, dtype=float)
-        problem = Problem(
-            result.mesh,
-            result.material,
-            result.thickness,
-            fibres=result.fibres,
-            prestress=result.prestress,
-        )
-        out.append(
-            replace(
-                result,
-                material_coordinates=coordinates,
-                energy=float(problem.energy(coordinates)),
-                _fields=None,
-            )
-        )
-    return out

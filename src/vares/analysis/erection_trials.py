@@ -12,15 +12,11 @@ the trial's own tangent is factorised as in any erection.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..solver.reuse import ReusingSolver, preconditioned_cg
-
-if TYPE_CHECKING:
-    from .erection import ErectionResult
 
 __all__ = ["ACCEPTANCE_ACCURACY", "TRIAL_TOLERANCE", "PrimedSolver", "predicted_positions"]
 
@@ -89,8 +85,9 @@ class PrimedSolver:
         return self.systems.exact(matrix, rhs, definite)
 
 
-def predicted_positions(erected: ErectionResult, dx: np.ndarray) -> np.ndarray:
-    """The erected positions ``(n, 3)`` moved by the linearised change ``dx`` (free dofs)."""
-    x = erected.erected_points.copy()
-    x.reshape(-1)[erected.context.assembler.free] += dx
+def predicted_positions(points: np.ndarray, free: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """Erected positions ``points`` ``(n, 3)`` moved by the linearised change ``dx`` of their
+    ``free`` dofs (indices into ``points.reshape(-1)``)."""
+    x = np.array(points, dtype=float)
+    x.reshape(-1)[free] += dx
     return x
