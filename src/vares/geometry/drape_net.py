@@ -24,13 +24,19 @@ nodes.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 
+from .face_walk import (
+    FaceWalk,
+    circle_intersections,
+    node_normals,
+    smooth_normals,
+    sphere_intersections,
+)
 from .mesh import SurfaceMesh
 from .surface_lines import triangulated
-from .surface_points import FaceLocator, barycentric, face_neighbours
+from .surface_points import FaceLocator, barycentric
 
 __all__ = [
     "NORMAL_CONE",
@@ -182,8 +188,8 @@ def kinematic_net(
     locator = FaceLocator(tri_mesh)
     size = float(np.linalg.norm(np.ptp(tri_mesh.points, axis=0)))
     face, bary, seed_point = locate_seed(tri_mesh, seed, locator)
-    node_normals = _node_normals(tri_mesh)
-    normal = _smooth_normals(node_normals, triangles, np.array([face]), bary[None])[0]
+    at_nodes = node_normals(tri_mesh)
+    normal = smooth_normals(at_nodes, triangles, np.array([face]), bary[None])[0]
     warp = np.asarray(warp_direction, dtype=float).reshape(3)
     length = float(np.linalg.norm(warp))
     warp = warp - (warp @ normal) * normal
@@ -194,11 +200,11 @@ def kinematic_net(
         )
     warp /= np.linalg.norm(warp)
     fill = np.cross(normal, warp)
-    walk = _Walk.of(tri_mesh, spacing)
+    walk = FaceWalk.of(tri_mesh, spacing)
     if generators is None:
         length = 2.0 * size if max_length is None else float(max_length)
         yarns, beyond = _geodesic_generators(
-            walk, node_normals, face, seed_point, normal, (warp, fill), spacing, length
+            walk, at_nodes, face, seed_point, normal, (warp, fill), spacing, length
         )
     else:
         halves = _given_generators(generators, seed_point, warp, fill)
@@ -247,45 +253,6 @@ def locate_seed(
     return int(face), bary, point
 
 
-def _node_normals(mesh: SurfaceMesh) -> np.ndarray:
-    """Unit normals ``(n, 3)`` at the nodes: the sums of the area vectors of the faces round
-    each node (an area-weighted mean)."""
-    triangles = mesh.cells["triangle"]
-    vectors = mesh.area_vectors()
-    normals = np.zeros((mesh.num_points, 3))
-    for corner in range(3):
-        np.add.at(normals, triangles[:, corner], vectors)
-    return normals / np.linalg.norm(normals, axis=1)[:, None]
-
-
-def _smooth_normals(node_normals, triangles, faces, bary) -> np.ndarray:
-    """The node normals interpolated at points ``faces`` ``(k,)``, ``bary`` ``(k, 3)``: unit
-    vectors ``(k, 3)`` that vary continuously over the mould, across its faces' sides too."""
-    normals = np.einsum("kc,kci->ki", bary, node_normals[triangles[faces]])
-    return normals / np.linalg.norm(normals, axis=1)[:, None]
-
-
-class _Walk(NamedTuple):
-    """A walk across the faces: their corners, unit normals, neighbours, triangles, and the
-    most faces a walk may cross."""
-
-    corners: np.ndarray
-    normals: np.ndarray
-    neighbours: np.ndarray
-    triangles: np.ndarray
-    max_steps: int
-
-    @classmethod
-    def of(cls, mesh: SurfaceMesh, spacing: float) -> _Walk:
-        triangles = mesh.cells["triangle"]
-        corners = mesh.points[triangles]
-        normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        normals /= np.linalg.norm(normals, axis=1)[:, None]
-        edge = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1).min()
-        steps = 64 + 8 * int(np.ceil(spacing / edge))  # a walk crosses about spacing / edge faces
-        return cls(corners, normals, face_neighbours(triangles), triangles, steps)
-
-
 def _geodesic_generators(
     walk, node_normals, face, seed, seed_normal, directions, spacing, length
 ) -> list[np.ndarray]:
@@ -313,7 +280,7 @@ def _geodesic_generators(
         along /= np.linalg.norm(along, axis=1)[:, None]
         across = normal[active]
         radius = np.full(len(active), float(spacing))
-        found, faces, off = _circle_intersections(
+        found, faces, off = circle_intersections(
             point[active], radius, along, across, where[active], walk, beyond=spacing
         )
         ok = faces >= 0
@@ -322,7 +289,7 @@ def _geodesic_generators(
         heading[rows] = found[ok] - point[rows]
         point[rows], where[rows] = found[ok], faces[ok]
         bary, _ = barycentric(found[ok], walk.corners[faces[ok]])
-        normal[rows] = _smooth_normals(node_normals, walk.triangles, faces[ok], bary)
+        normal[rows] = smooth_normals(node_normals, walk.triangles, faces[ok], bary)
         for r in rows:
             yarns[r].append(point[r].copy())
             beyond[r].append(r in edge)
@@ -345,7 +312,7 @@ def _given_generators(generators, seed, warp, fill) -> list[np.ndarray]:
     return halves
 
 
-def _march(positions, faces, off, seed, spacing, walk: _Walk) -> None:
+def _march(positions, faces, off, seed, spacing, walk: FaceWalk) -> None:
     """Fill the nodes off the generator yarns in place, by anti-diagonals from the seed:
     ``positions``, ``faces`` (the face each node's walk ended in) and ``off`` (the node lies
     beyond the mould's edge, in that face's plane)."""
@@ -363,7 +330,7 @@ def _march(positions, faces, off, seed, spacing, walk: _Walk) -> None:
         ta, tb, ia, jb, start = ta[ready], tb[ready], ia[ready], jb[ready], start[ready]
         if not ta.size:
             continue
-        point, face, beyond = _sphere_intersections(
+        point, face, beyond = sphere_intersections(
             positions[ia, jb],
             positions[ia, tb],
             positions[ta, jb],
@@ -374,89 +341,3 @@ def _march(positions, faces, off, seed, spacing, walk: _Walk) -> None:
         positions[ta, tb] = point
         faces[ta, tb] = face
         off[ta, tb] = beyond
-
-
-def _sphere_intersections(p0, p1, p2, start, spacing, walk: _Walk):
-    """The points ``(k, 3)`` of the mesh at the distance ``spacing`` from both ``p1`` and ``p2``
-    ``(k, 3)``, on the side away from ``p0``, their faces ``(k,)`` (NaN and −1 where there is
-    none) and whether they lie beyond the mould's edge ``(k,)`` (:func:`_circle_intersections`,
-    within ``spacing``), walking from the faces ``start``."""
-    chord = p2 - p1
-    distance = np.linalg.norm(chord, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        e = chord / distance[:, None]
-    centre = 0.5 * (p1 + p2)
-    radius_sq = spacing**2 - 0.25 * distance**2
-    radius = np.sqrt(np.clip(radius_sq, 0.0, None))
-    away = centre - p0
-    away -= np.einsum("ki,ki->k", away, e)[:, None] * e
-    with np.errstate(invalid="ignore", divide="ignore"):
-        along = away / np.linalg.norm(away, axis=1)[:, None]
-    across = np.cross(e, along)
-    # the rhombus (p0, p1, ·, p2) has the yarn angle 2 arcsin(distance / 2 spacing) at p0:
-    # distance → 0 or → 2 spacing is a cell sheared to ±90°, where the net ends
-    usable = (radius_sq > 1e-12 * spacing**2) & (distance > 1e-6 * spacing)
-    return _circle_intersections(centre, radius, along, across, start, walk, usable, beyond=spacing)
-
-
-def _circle_intersections(
-    centre, radius, along, across, start, walk: _Walk, usable=None, beyond: float = 0.0
-):
-    """The points ``(k, 3)`` where the circles ``centre + radius (cos θ along + sin θ across)``
-    (``(k, 3)``, ``(k,)``, unit ``along`` ⟂ ``across``) meet the mesh, the root nearer to
-    ``along``, their faces ``(k,)`` (NaN and −1 where there is none, or not ``usable``), and
-    ``(k,)`` whether the point lies beyond the mould's edge: a walk that would leave the mould
-    across a boundary side takes the root in the plane of the boundary face when it lies within
-    ``beyond`` of that face (the net runs on over the edge), else none; walking from the faces
-    ``start``."""
-    corners, normals, neighbours = walk.corners, walk.normals, walk.neighbours
-    count = len(centre)
-    point = np.full((count, 3), np.nan)
-    found = np.full(count, -1, dtype=np.int64)
-    off = np.zeros(count, dtype=bool)
-    face, previous = start.copy(), np.full(count, -1, dtype=np.int64)
-    active = np.arange(count) if usable is None else np.flatnonzero(usable)
-    for _ in range(walk.max_steps):
-        if not active.size:
-            break
-        f = face[active]
-        n = normals[f]
-        alpha = np.einsum("ki,ki->k", n, along[active])
-        beta = np.einsum("ki,ki->k", n, across[active])
-        rho = np.hypot(alpha, beta)
-        offset = np.einsum("ki,ki->k", n, corners[f, 0] - centre[active])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            c = offset / (radius[active] * rho)
-        reaches = np.abs(c) <= 1.0
-        phi, delta = np.arctan2(beta, alpha), np.arccos(np.clip(c, -1.0, 1.0))
-        theta = np.where(np.cos(phi + delta) >= np.cos(phi - delta), phi + delta, phi - delta)
-        q = centre[active] + radius[active, None] * (
-            np.cos(theta)[:, None] * along[active] + np.sin(theta)[:, None] * across[active]
-        )
-        lam, _ = barycentric(q, corners[f])
-        worst = np.argmin(lam, axis=1)
-        inside = lam[np.arange(len(f)), worst] >= -1e-9
-        step = neighbours[f, worst]
-        # stepping back to the face it came from: the root lies on the side the two share
-        back = ~inside & (step >= 0) & (step == previous[active]) & reaches
-        if back.any():
-            clamped = np.clip(lam[back], 0.0, None)
-            clamped /= clamped.sum(axis=1, keepdims=True)
-            q[back] = np.einsum("kc,kci->ki", clamped, corners[f[back]])
-        outside = ~inside & ~back & (step < 0) & reaches
-        if beyond > 0 and outside.any():
-            clamped = np.clip(lam[outside], 0.0, None)
-            clamped /= clamped.sum(axis=1, keepdims=True)
-            foot = np.einsum("kc,kci->ki", clamped, corners[f[outside]])
-            near = np.linalg.norm(q[outside] - foot, axis=1) <= beyond
-            off[active[np.flatnonzero(outside)[near]]] = True
-            outside[np.flatnonzero(outside)[~near]] = False
-        else:
-            outside[:] = False
-        done = (inside | back | outside) & reaches
-        point[active[done]], found[active[done]] = q[done], f[done]
-        moving = ~inside & ~back & (step >= 0)
-        previous[active[moving]] = f[moving]
-        face[active[moving]] = step[moving]
-        active = active[moving]
-    return point, found, off

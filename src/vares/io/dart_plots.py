@@ -7,7 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..analysis.darts import DartedPattern
-from ..geometry.mesh import SurfaceMesh
+from ..geometry.face_walk import node_normals
 
 __all__ = ["plot_darts"]
 
@@ -62,9 +62,9 @@ def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
         if lines:
             from scipy.spatial import cKDTree
 
-            node_normals, tree = _node_normals(mesh), cKDTree(mesh.points)
+            at_nodes, tree = node_normals(mesh), cKDTree(mesh.points)
         for line in lines:  # the parts on the side seen, lifted off the surface a little
-            normals = node_normals[tree.query(line)[1]]
+            normals = at_nodes[tree.query(line)[1]]
             lifted = line + 0.01 * size * normals
             seen = (normals @ towards > 0)[:-1] & (normals @ towards > 0)[1:]
             segments.append(np.stack([lifted[:-1], lifted[1:]], axis=1)[seen])
@@ -105,13 +105,3 @@ def plot_darts(darted: DartedPattern, dpi: float = 100) -> plt.Figure:
         mappable, ax=fig.axes, shrink=0.7, label="shear angle [°] (red: at the locking angle)"
     )
     return fig
-
-
-def _node_normals(mesh: SurfaceMesh) -> np.ndarray:
-    """Unit normals ``(n, 3)`` of the mesh at its nodes (the sum of their cells' area vectors)."""
-    triangles = mesh.cells["triangle"]
-    vectors = mesh.area_vectors()
-    normals = np.zeros_like(mesh.points)
-    for k in range(3):
-        np.add.at(normals, triangles[:, k], vectors)
-    return normals / np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
