@@ -40,7 +40,7 @@ import numpy as np
 from ..geometry.cutting import SNAP, CutMesh, LinesMeetError, cut_mesh
 from ..geometry.line_families import LineFamily, geodesic_between_ends, line_family
 from ..geometry.mesh import SurfaceMesh
-from ..geometry.refine import MAX_ROUNDS, refine
+from ..geometry.refine import refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
 from .panels import Panel, split_panels
 from .strip_plan import StripPlan
@@ -171,10 +171,12 @@ def plan_strips(
 def refined_cells(surface: SurfaceMesh, longest: float) -> float:
     """About how many triangles the triangle mesh ``surface`` has once refined on its own faces
     until no edge is longer than ``longest`` (each halving of a cell's longest edge a 1-to-4
-    split, at most :data:`~vares.geometry.refine.MAX_ROUNDS` of them)."""
+    split): what the width asks for, even where that takes more than the
+    :data:`~vares.geometry.refine.MAX_ROUNDS` rounds a refinement does (a roll that narrow is
+    refused, not planned on a surface too coarse for it)."""
     corners = surface.points[surface.cells["triangle"]]
     edges = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1).max(axis=1)
-    halvings = np.minimum(np.ceil(np.log2(np.maximum(edges / longest, 1.0))), MAX_ROUNDS)
+    halvings = np.ceil(np.log2(np.maximum(edges / longest, 1.0)))
     return float(np.sum(4.0**halvings))
 
 
