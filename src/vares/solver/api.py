@@ -122,11 +122,13 @@ def _load_kernels(mesh: SurfaceMesh, material: Hyperelastic, solver: str | None)
     started = time.perf_counter()
     if not compiled(mesh.num_cells):  # a small mesh's kernels run as numpy: nothing to load
         return 0.0
+    loaded = False
     for cell_type, cells in mesh.cells.items():
         key = (cell_type, type(material), solver)
         if key in _WARM:
             continue
         _WARM.add(key)
+        loaded = True
         nodes = cells[0]
         single = SurfaceMesh(mesh.points[nodes], {cell_type: np.arange(len(nodes))[None, :]})
         try:
@@ -134,7 +136,7 @@ def _load_kernels(mesh: SurfaceMesh, material: Hyperelastic, solver: str | None)
                 _solve(single, material, 1.0, None, SolveOptions(linear_solver=solver), None, None)
         except Exception:  # a warm-up only: the real solve reports any trouble
             pass
-    return time.perf_counter() - started
+    return time.perf_counter() - started if loaded else 0.0
 
 
 def _solve(mesh, material, thickness, prestress, options, callback, given) -> PatternResult:
