@@ -256,3 +256,23 @@ def test_a_held_anisotropic_solve_reuses_its_bordered_factorisation():
         np.testing.assert_allclose(
             inexact.material_coordinates, exact.material_coordinates, atol=1e-10 * 10.0
         )
+
+
+def test_a_primed_solver_solves_by_the_primer_until_it_needs_more_or_factorises():
+    from scipy.sparse.linalg import splu
+
+    matrix = _laplacian(15)  # 225 unknowns
+    nearby = splu((matrix * 1.02).tocsc())  # a nearby matrix's factorisation
+    rhs = np.random.default_rng(0).standard_normal(matrix.shape[0])
+    systems = ReusingSolver(linear.get_solver("scipy-superlu"))
+    systems.prime(nearby.solve, 6)
+    x = systems.solve(matrix, rhs, rtol=1e-8)
+    assert np.linalg.norm(matrix @ x - rhs) <= 1e-8 * np.linalg.norm(rhs)
+    assert systems.factorisations == 0 and 0 < systems.cg_iterations <= 6
+    # a primer too far off for its budget gives way to a factorisation, and is dropped
+    far = splu((matrix * 3.0 + sp.identity(matrix.shape[0])).tocsc())
+    systems.prime(far.solve, 1)
+    x = systems.solve(matrix, rhs, rtol=1e-12)
+    assert systems.factorisations == 1
+    assert np.linalg.norm(matrix @ x - rhs) <= 1e-10 * np.linalg.norm(rhs)
+    assert systems._primer is None

@@ -33,7 +33,7 @@ from ..solver.reuse import ETA_MAX, ETA_MAX_KINKED, ReusingSolver
 from ..solver.strategies import Attempt, follow_plan
 from .erection_fields import erection_statistics, membrane_forces, node_normals
 from .erection_model import Pattern, Structure, build_structure, dof_map, patterns_of
-from .erection_trials import PrimedSolver
+from .erection_trials import PRIMED_ITERATIONS
 from .options import ErectionOptions
 
 __all__ = ["ErectionResult", "Pattern", "erect", "erection_defaults"]
@@ -228,7 +228,7 @@ def erect(
         A solve with the factorised tangent of a nearby erected state (free dofs, as
         ``ErectionResult.context``'s): Newton's steps are solved by conjugate gradients
         preconditioned by it while that takes a few iterations
-        (:class:`~vares.analysis.erection_trials.PrimedSolver`).
+        (:meth:`~vares.solver.reuse.ReusingSolver.prime`).
     options, settings
         :class:`ErectionOptions` and any of its fields as keywords (listed below).
 
@@ -254,7 +254,7 @@ def erect(
     )
     ctx = _context(problem, held, solver, callback, options.erection_iterations)
     if primer is not None:
-        ctx.systems = PrimedSolver(ctx.systems, primer)
+        ctx.systems.prime(primer, PRIMED_ITERATIONS)
     x, path, reason = design.copy(), [], None
     if start is not None:
         x[~held] = _checked_start(start, design)[~held]

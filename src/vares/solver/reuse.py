@@ -19,6 +19,7 @@ factorised, not iterated on) or its rate shows it would overrun the budget.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -121,15 +122,26 @@ class ReusingSolver:
     """A :class:`~vares.solver.linear.LinearSolver` used for a sequence of Newton systems of one
     size: :meth:`solve` with a tolerance first tries conjugate gradients preconditioned by the
     last factorisation, within the back end's ``reuse_iterations`` (0: never); it factorises
-    the matrix when that fails or when an exact solution is asked for. Counts its work."""
+    the matrix when that fails or when an exact solution is asked for. Counts its work.
+
+    :meth:`prime` gives it, before its first factorisation, a preconditioner from elsewhere (a
+    solve with the factorisation of a nearby matrix of the same size): the first systems are
+    tried with that one, until one needs more than its budget or a factorisation is made."""
 
     def __init__(self, solver: LinearSolver) -> None:
         self.solver = solver
         self.budget = solver.reuse_iterations
         self._size: int | None = None
+        self._primer: Callable[[np.ndarray], np.ndarray] | None = None
+        self._primer_budget = 0
         #: numeric factorisations and conjugate-gradient iterations so far (failed ones too)
         self.factorisations = 0
         self.cg_iterations = 0
+
+    def prime(self, preconditioner: Callable[[np.ndarray], np.ndarray], budget: int) -> None:
+        """Precondition the systems before the first factorisation by ``preconditioner``, at
+        most ``budget`` conjugate-gradient iterations each (0: not at all)."""
+        self._primer, self._primer_budget = (preconditioner if budget > 0 else None), budget
 
     def solve(
         self,
@@ -151,6 +163,12 @@ class ReusingSolver:
                 return self.solver.solve(r)
             return self.solver.solve(np.append(r, 0.0))[:-1]
 
+        if rtol > 0 and self._primer is not None and constraint is None:
+            x, iterations = preconditioned_cg(matrix, rhs, self._primer, rtol, self._primer_budget)
+            self.cg_iterations += iterations
+            if x is not None:
+                return x
+            self._primer = None  # the systems have moved too far from the primer's matrix
         if rtol > 0 and self.budget > 0 and self._size == size:
             x, iterations = preconditioned_cg(matrix, rhs, solve, rtol, self.budget, constraint)
             self.cg_iterations += iterations
@@ -164,7 +182,7 @@ class ReusingSolver:
 
     def exact(self, matrix: sp.spmatrix, rhs: np.ndarray, definite: bool = False) -> np.ndarray:
         """Factorise ``matrix`` (it becomes the preconditioner of later solves) and solve."""
-        self._size = None
+        self._size, self._primer = None, None
         self.factorisations += 1
         self.solver.factorize(matrix, definite=definite)
         self._size = matrix.shape[0]
