@@ -14,25 +14,18 @@ from .flags import (
     JOB_FLAGS,
     SEAMS_FLAG,
     InputError,
+    example_flag,
     flags,
     job_from_flags,
-    option_parameter,
     with_flags,
 )
 from .pattern import RUN_FLAGS
 
 __all__ = ["cut"]
 
-EXAMPLE_FLAG = [
-    option_parameter(
-        "example",
-        None,
-        str | None,
-        "--example",
-        help="Cut a shipped surface instead: " + ", ".join([*CUT_EXAMPLES, *EXAMPLES]) + ".",
-        panel="Input",
-    )
-]
+EXAMPLE_FLAG = example_flag(
+    "Cut a shipped surface instead: " + ", ".join([*CUT_EXAMPLES, *EXAMPLES]) + "."
+)
 
 
 @with_flags(

@@ -16,7 +16,7 @@ from ...analysis.drape_options import DrapeOptions
 from ...units import METRES
 from ..sections import MaterialOptions
 from .common import console, guarded
-from .flags import InputError, build, flags, option_parameter, with_flags
+from .flags import InputError, build, example_flag, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
 __all__ = ["DRAPE_EXAMPLES", "DrapeExample", "darts_verdict", "drape"]
@@ -98,18 +98,11 @@ OUTPUT_FLAGS = [
     ),
 ]
 
-EXAMPLE_FLAG = [
-    option_parameter(
-        "example",
-        None,
-        str | None,
-        "--example",
-        help="Drape a shipped mould instead, from its own seed, warp and spacing unless given: "
-        + ", ".join(DRAPE_EXAMPLES)
-        + ".",
-        panel="Input",
-    )
-]
+EXAMPLE_FLAG = example_flag(
+    "Drape a shipped mould instead, from its own seed, warp and spacing unless given: "
+    + ", ".join(DRAPE_EXAMPLES)
+    + "."
+)
 
 
 @with_flags(

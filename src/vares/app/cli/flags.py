@@ -33,6 +33,7 @@ __all__ = [
     "InputError",
     "build",
     "erection_from_flags",
+    "example_flag",
     "flag_name",
     "flags",
     "job_from_flags",
@@ -73,6 +74,11 @@ def option_parameter(
     return inspect.Parameter(
         name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation
     )
+
+
+def example_flag(help: str) -> list[inspect.Parameter]:
+    """A command's ``--example NAME``: a shipped input in place of the file argument."""
+    return [option_parameter("example", None, str | None, "--example", help=help, panel="Input")]
 
 
 def flag_name(name: str, spec: Spec, prefix: str = "") -> str:

@@ -9,21 +9,21 @@ from ...geometry.examples import STRUCTURE_EXAMPLES
 from ...structures.options import StructureOptions
 from ..sections import InputOptions
 from .common import execute, guarded
-from .flags import JOB_FLAGS, InputError, flags, job_from_flags, option_parameter, with_flags
+from .flags import (
+    JOB_FLAGS,
+    InputError,
+    example_flag,
+    flags,
+    job_from_flags,
+    with_flags,
+)
 from .pattern import RUN_FLAGS
 
 __all__ = ["panels"]
 
-EXAMPLE_FLAG = [
-    option_parameter(
-        "example",
-        None,
-        str | None,
-        "--example",
-        help="Pattern a shipped structure instead: " + ", ".join(STRUCTURE_EXAMPLES) + ".",
-        panel="Input",
-    )
-]
+EXAMPLE_FLAG = example_flag(
+    "Pattern a shipped structure instead: " + ", ".join(STRUCTURE_EXAMPLES) + "."
+)
 
 
 @with_flags(
