@@ -22,7 +22,7 @@ import numpy as np
 
 from .._jit import compiled, njit
 
-__all__ = ["CellImage", "View", "rasterise", "triangles_of"]
+__all__ = ["CellImage", "View", "covered", "rasterise", "triangles_of"]
 
 #: Pixels along the longer side of a cell image unless told (a 6.5-inch figure at 150 dpi is 975
 #: wide).
@@ -144,20 +144,48 @@ def rasterise(
     return CellImage(index, extent, buffer)
 
 
-def _fill_spans(
-    px: np.ndarray,
-    py: np.ndarray,
-    pz: np.ndarray,
-    triangles: np.ndarray,
-    owners: np.ndarray,
-    index: np.ndarray,
-    depth: np.ndarray,
-) -> None:
-    """:func:`_fill` for cells seen flat (``pz`` zero: the first triangle over a pixel takes
-    it) as array arithmetic, for small meshes: each triangle's run of pixel centres along each
-    row, from where its edges cross the row; the pixels at either end of a run are tested as
-    :func:`_fill` tests every pixel (the same weights), those between lie inside."""
-    rows, columns = index.shape
+def covered(
+    cells: Mapping[str, np.ndarray],
+    coordinates: np.ndarray,
+    grid: tuple[float, float, float, int, int],
+) -> np.ndarray:
+    """The pixels of ``grid`` (as :func:`rasterise`'s) that any of the ``cells`` covers, a
+    boolean image ``(rows, columns)``: ``rasterise(cells, coordinates, grid=grid).index >= 0``,
+    the same pixels, without finding which cell each pixel shows. Below the compiled kernels'
+    size each run of pixels is filled whole (its two ends tested as :func:`_fill_spans` tests
+    them), not pixel by pixel."""
+    x0, y0, h, columns, rows = grid
+    triangles, _ = triangles_of(cells)
+    if compiled(len(triangles)):
+        return rasterise(cells, coordinates, grid=grid).index >= 0
+    pixel_coordinates = (np.asarray(coordinates, dtype=float) - np.array([x0, y0])) / h
+    px, py = pixel_coordinates[:, 0].copy(), pixel_coordinates[:, 1].copy()
+    t, y, start, length = _spans(px, py, triangles, rows, columns)
+    # the pixels between the two tested at either end of a run lie inside: a run of them adds
+    # 1 at its first pixel and takes it off after its last, summed along the row
+    inner = length > 4
+    row = (y[inner] - 0.5).astype(np.int64) * (columns + 1)
+    first = row + (start[inner] + 2).astype(np.int64)
+    after = row + (start[inner] + length[inner] - 2).astype(np.int64)
+    size = rows * (columns + 1)
+    steps = np.bincount(first, minlength=size) - np.bincount(after, minlength=size)
+    image = np.cumsum(steps.reshape(rows, columns + 1), axis=1)[:, :columns] > 0
+    for end in (0, 1, -2, -1):  # the offsets in a run that _fill_spans tests
+        offset = length + end if end < 0 else np.full_like(length, end)
+        exists = (offset >= 0) & (offset < length)
+        e, i, ye = t[exists], start[exists] + offset[exists], y[exists]
+        keep = _inside(px, py, triangles, e, i + 0.5, ye)
+        image[(ye[keep] - 0.5).astype(np.int64), i[keep].astype(np.int64)] = True
+    return image
+
+
+def _spans(
+    px: np.ndarray, py: np.ndarray, triangles: np.ndarray, rows: int, columns: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each triangle's run of pixel centres along each row it crosses (for cells seen flat):
+    the triangle, the row's centre ``y``, the run's first pixel and its length (0: none). The
+    run is bounded from where the triangle's edges cross the row, one pixel wider at either end;
+    its two pixels at either end are to be tested, those between lie inside."""
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     xa, ya, xb, yb, xc, yc = px[a], py[a], px[b], py[b], px[c], py[c]
     area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
@@ -189,17 +217,45 @@ def _fill_spans(
     start = np.maximum(np.ceil(low - 0.5) - 1, i0[t])
     stop = np.minimum(np.floor(high - 0.5) + 1, i1[t])
     length = np.where(stop >= start, stop - start + 1, 0).astype(np.int64)
+    return t, y, start, length
+
+
+def _inside(
+    px: np.ndarray, py: np.ndarray, triangles: np.ndarray, t: np.ndarray, x: np.ndarray,
+    y: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """Whether each point ``(x, y)`` lies in its triangle ``t``, as :func:`_fill` tests a pixel
+    centre (the same weights, the same tolerance)."""
+    a, b, c = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+    xa, ya, xb, yb, xc, yc = px[a], py[a], px[b], py[b], px[c], py[c]
+    area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
+    wa = ((xb - x) * (yc - y) - (xc - x) * (yb - y)) / area
+    wb = ((xc - x) * (ya - y) - (xa - x) * (yc - y)) / area
+    wc = 1.0 - wa - wb
+    return (wa >= -1e-12) & (wb >= -1e-12) & (wc >= -1e-12)
+
+
+def _fill_spans(
+    px: np.ndarray,
+    py: np.ndarray,
+    pz: np.ndarray,
+    triangles: np.ndarray,
+    owners: np.ndarray,
+    index: np.ndarray,
+    depth: np.ndarray,
+) -> None:
+    """:func:`_fill` for cells seen flat (``pz`` zero: the first triangle over a pixel takes
+    it) as array arithmetic, for small meshes: each triangle's run of pixel centres along each
+    row (:func:`_spans`); the pixels at either end of a run are tested as :func:`_fill` tests
+    every pixel (the same weights), those between lie inside."""
+    rows, columns = index.shape
+    t, y, start, length = _spans(px, py, triangles, rows, columns)
     t, y, start = np.repeat(t, length), np.repeat(y, length), np.repeat(start, length)
     offset = np.arange(t.size) - np.repeat(np.cumsum(length) - length, length)
     i = start + offset
     end = (offset < 2) | (np.repeat(length, length) - offset <= 2)  # the ends: tested
-    e, x, ye = t[end], i[end] + 0.5, y[end]
-    xa, ya, xb, yb, xc, yc, area = xa[e], ya[e], xb[e], yb[e], xc[e], yc[e], area[e]
-    wa = ((xb - x) * (yc - ye) - (xc - x) * (yb - ye)) / area
-    wb = ((xc - x) * (ya - ye) - (xa - x) * (yc - ye)) / area
-    wc = 1.0 - wa - wb
     keep = np.ones(t.size, dtype=bool)
-    keep[end] = (wa >= -1e-12) & (wb >= -1e-12) & (wc >= -1e-12)
+    keep[end] = _inside(px, py, triangles, t[end], i[end] + 0.5, y[end])
     pixel = (y[keep] - 0.5).astype(np.int64) * columns + i[keep].astype(np.int64)
     t = t[keep]
     free = depth.reshape(-1)[pixel] > 0.0  # z = 0 is nearer than what the pixel holds

@@ -38,7 +38,7 @@ def paint_png(
     """The primitives ``items`` (:mod:`vares.io.drawing`, in figure points) of a picture of
     ``size`` (width, height, points) with its ``axes`` box (left, top, width, height), their
     ``ticks`` ``(axis, position in points, label)`` and ``title``, painted at ``dpi`` as PNG
-    bytes; cells are rasterised at the picture's own pixels (:func:`vares.io.raster.rasterise`),
+    bytes; cells are rasterised at the picture's own pixels (:func:`vares.io.raster.covered`),
     lines at 3 × 3 samples a pixel."""
     from PIL import Image, ImageColor, ImageDraw
 
@@ -51,10 +51,14 @@ def paint_png(
     leading = 0
     while leading < len(items) and isinstance(items[leading], FilledCells):
         leading += 1
-    base = np.full((pixels[1], pixels[0], 3), 255, dtype=np.uint8)
-    for item in items[:leading]:
-        base[_covered(item, pixels, dpi)] = ImageColor.getrgb(item.colour)[:3]
-    image = Image.fromarray(base).resize(
+    leading = min(leading, 255)  # each a grey level of the labels below
+    labels = np.zeros((pixels[1], pixels[0]), dtype=np.uint8)  # 0: white, n: the n-th item's
+    for n, item in enumerate(items[:leading], start=1):
+        labels = np.where(_covered(item, pixels, dpi), np.uint8(n), labels)
+    colours = [(255, 255, 255)] + [ImageColor.getrgb(i.colour)[:3] for i in items[:leading]]
+    bands = [[c[band] for c in colours] + [0] * (256 - len(colours)) for band in range(3)]
+    grey = Image.fromarray(labels, mode="L")
+    image = Image.merge("RGB", [grey.point(band) for band in bands]).resize(
         (pixels[0] * SUPERSAMPLE, pixels[1] * SUPERSAMPLE), Image.Resampling.NEAREST
     )
     draw = ImageDraw.Draw(image)
@@ -121,10 +125,9 @@ def paint_png(
 
 def _covered(item: FilledCells, pixels: tuple[int, int], dpi: float) -> np.ndarray:
     """The pixels (rows downwards, as the picture's) that the cells of ``item`` cover."""
-    from .raster import rasterise
+    from .raster import covered
 
-    grid = (0.0, 0.0, 1.0, pixels[0], pixels[1])
-    return rasterise(item.cells, item.points * dpi / POINT, grid=grid).index >= 0
+    return covered(item.cells, item.points * dpi / POINT, grid=(0.0, 0.0, 1.0, *pixels))
 
 
 def _font(size: float):
