@@ -16,11 +16,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..analysis.erection import ErectionResult
 from ..io.files import atomic_path, write_json
 from ..io.meshes import write_surface
 
 if TYPE_CHECKING:
+    from ..analysis.erection import ErectionResult
     from ..analysis.erection_optimum import OptimisedPatterns
 
 __all__ = [

@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..analysis.erection import ErectionResult, erect
 from ..analysis.options import ErectionOptions
 from ..solver import IterationRecord
 from .erection_outputs import erection_files, write_erection
@@ -15,6 +15,9 @@ from .inputs import saved_patterns, saved_units
 from .job import Job, load_job
 from .outputs import JOB_FILE
 from .staging import OutputFolder, add_to_manifest, listed
+
+if TYPE_CHECKING:
+    from ..analysis.erection import ErectionResult
 
 __all__ = ["ErectionRun", "run_erection"]
 
@@ -65,6 +68,8 @@ def run_erection(
         known=[p for p in listed(directory) if target.resolve() in p.resolve().parents],
     )
     folder.check()
+    from ..analysis.erection import erect  # imported when erecting
+
     result = erect(
         patterns,
         material,

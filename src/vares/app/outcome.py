@@ -6,21 +6,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..analysis.compensation import CompensationReport
-from ..analysis.erection import ErectionResult
-from ..geometry.mesh import SurfaceMesh
-from ..materials import Hyperelastic
-from ..solver.result import PatternResult
-from ..structures.cutting import CutResult
-from ..structures.matching import StructureResult
 from ..units import unit_factor
-from .job import Job
 from .sections import STRUCTURE_MARK_SPACING
 
 if TYPE_CHECKING:  # made (and their modules imported) only when a job asks for them
+    from ..analysis.compensation import CompensationReport
     from ..analysis.drape import PlyDrape
+    from ..analysis.erection import ErectionResult
     from ..analysis.erection_optimum import OptimisedPatterns
+    from ..geometry.mesh import SurfaceMesh
+    from ..materials import Hyperelastic
+    from ..solver.result import PatternResult
+    from ..structures.cutting import CutResult
+    from ..structures.matching import StructureResult
     from .band_result import RunBand
+    from .job import Job
 
 __all__ = ["JobOutcome", "PanelOutcome"]
 

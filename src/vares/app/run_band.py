@@ -27,7 +27,6 @@ from ..materials.presets import FabricPreset, fabric, file_fabric
 from ..solver.options import SolveOptions
 from ..structures.panels import Panel
 from .band_result import RunBand
-from .fabric_band import fabric_band, structure_figures
 from .job import Job, JobError
 from .outcome import JobOutcome
 
@@ -105,6 +104,8 @@ def check_run_band(job: Job) -> BandInputs | None:
 def run_band(outcome: JobOutcome, inputs: BandInputs, options: SolveOptions) -> RunBand:
     """The band of a run's patterns (module docs); a case that does not converge gives a band
     with its ``reason`` instead (and a warning in the outcome)."""
+    from .fabric_band import fabric_band, structure_figures  # imported by a run with a band
+
     job = outcome.job
     settings: dict[str, Any] = {"options": options}
     structure = outcome.structure

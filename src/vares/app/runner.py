@@ -19,14 +19,12 @@ import numpy as np
 
 from ..analysis.checks import pattern_warnings
 from ..analysis.compensation import compensation_report
-from ..analysis.erection import erect
 from ..analysis.erection_model import Pattern
 from ..geometry.examples import EXAMPLE_PLANES
 from ..geometry.mesh import SurfaceMesh
 from ..io.files import check_writable, write_text
 from ..materials import Hyperelastic
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
-from ..structures.matching import solve_structure
 from .erection_outputs import write_erection
 from .erection_run import ErectionRun, run_erection
 from .inputs import Input, load_input
@@ -202,6 +200,8 @@ def _erect(outcome: JobOutcome, options, callback) -> None:
     if job.erection.optimise:
         _optimise(outcome, patterns, options)
         return
+    from ..analysis.erection import erect  # imported by a job that erects
+
     outcome.erection = erect(
         patterns,
         outcome.material,
@@ -317,6 +317,8 @@ def _solve_structure(job, source: Input, material, options, callback) -> JobOutc
         per_panel = [job.prestress.value(data) for data in source.panel_cell_data]
         if len(per_panel) != len(source.panels):  # a Rhino model's objects carry no cell data
             raise JobError("per-cell prestress needs the panels' cell data (a mesh file's)")
+    from ..structures.matching import solve_structure  # imported by a structure's job
+
     structure = solve_structure(
         source.panels,
         material,
