@@ -3,7 +3,9 @@ and the report, for a 512-triangle sail, a small roof, a 20k-triangle scan and a
 hypar.
 
     python benchmarks/around_the_solve.py [--repeat 5] [--sizes sail small scan large] [--first]
-    python benchmarks/around_the_solve.py --breakdown [--repeat 5] [--sizes sail]
+    python benchmarks/around_the_solve.py --breakdown [--repeat 5] [--sizes sail] [--no-quiet]
+    python benchmarks/around_the_solve.py --libraries [--repeat 5]
+    PYTHONPATH=src python benchmarks/around_the_solve.py --against OLD/src [--repeat 9]
 
 Every run is a fresh `vares pattern FILE -o DIR --force` process (compiled kernels cached on
 disk, as after the first run of an install), in three variants: `--no-previews`, the default
@@ -11,8 +13,9 @@ disk, as after the first run of an install), in three variants: `--no-previews`,
 CPU seconds (user + system, as the operating system counts them: the steadier figure on a
 machine shared with other work), the solve's own time (``elapsed_seconds`` +
 ``warm_up_seconds`` of summary.json) and what the report adds; and, first, what merely loading
-the libraries a run may use costs: a script that imports them and calls one compiled (cached)
-numba function. ``--first``: also the first run after an install, numba's cache of compiled
+the libraries a small run imports costs: a script that imports them (numba is not among them:
+below 2,000 cells the kernels run as numpy; ``--libraries`` gives each one's share).
+``--first``: also the first run after an install, numba's cache of compiled
 kernels empty (``NUMBA_CACHE_DIR`` a new folder each run). The command is the ``vares``
 script installed beside this Python (a version manager's shim on PATH, such as pyenv's, adds
 its own start-up: 0.08 s here), else the one on PATH; it imports the package from PYTHONPATH
@@ -28,7 +31,16 @@ medians over fresh processes: starting Python, importing the command line, readi
 the mesh, loading the solver's compiled kernels, the solve, each output file (the first file to
 need a library imports it: the DXF's time includes ezdxf's import), and the rest (arguments,
 options, the job file, moving the staging folder into place, exiting); then the libraries'
-import times (``-X importtime``, summed per top-level package).
+import times (``-X importtime``, summed per top-level package). The command line's part is
+told apart: importing typer, importing the subcommand (numpy, scipy.sparse and the options
+with it), and parsing the arguments (typer coerces every parameter through a pydantic
+``TypeAdapter``: pydantic's import and one adapter a parameter). ``--no-quiet``: the run
+prints its progress and summary (to a pipe), as a user sees it, instead of ``-q``.
+
+``--against SRC``: a default run of this tree and of the sources at SRC (another checkout's
+``src/``, e.g. a ``git worktree`` of an earlier commit), in turn, pair by pair: the medians and
+the ratio of the two, wall and CPU seconds (on a loaded machine the ratio of one run is what to
+quote).
 """
 
 from __future__ import annotations
@@ -95,17 +107,61 @@ def first_run(path: Path, folder: Path) -> tuple[float, float]:
         del ENVIRONMENT["NUMBA_CACHE_DIR"]
 
 
-#: What a `vares pattern` run loads, without vares: the floor of its time.
-LIBRARIES = """\
-import numpy as np, scipy.sparse, scipy.sparse.csgraph, scipy.sparse.linalg, numba
-import ezdxf, typer, rich, meshio, shapely, PIL.Image
-
-@numba.njit(cache=True)
-def first(x):
-    return x.sum()
-
-first(np.ones(3))
+#: pypardiso imported as vares imports it: told where MKL's runtime is, it does not search the
+#: whole environment for it (vares.solver.linear).
+PARDISO = """\
+import os, pathlib, sys
+os.environ.setdefault("PYPARDISO_MKL_RT", str(next(iter(sorted(
+    pathlib.Path(sys.prefix, "lib").glob("libmkl_rt.so*"), key=lambda p: len(p.name))), "")))
+import pypardiso, threadpoolctl
 """
+
+#: What a small `vares pattern` run loads, without vares (below 2,000 cells numba is not
+#: imported), in the order the run imports it, one step a line: the floor of its time.
+LIBRARY_STEPS = [
+    ("typer", "import typer"),
+    ("numpy", "import numpy"),
+    ("numpy.f2py, numpy.testing (scipy's array-API layer lists numpy's modules)",
+     "import numpy.f2py, numpy.testing"),
+    ("scipy.sparse", "import scipy.sparse"),
+    ("scipy.sparse.csgraph (it imports scipy.sparse.linalg, scipy.linalg)",
+     "import scipy.sparse.csgraph"),
+    ("pydantic (typer's parameters)", "import pydantic; pydantic.TypeAdapter"),
+    ("rich", "import rich.console, rich.table"),
+    ("pypardiso, threadpoolctl (told where MKL is, as vares tells it)", PARDISO),
+    ("shapely", "import shapely"),
+    ("meshio", "import meshio"),
+    ("ezdxf (pyparsing, fontTools)", "import ezdxf"),
+    ("Pillow", "import PIL.Image, PIL.ImageDraw, PIL.ImageFont"),
+]  # fmt: skip
+LIBRARIES = "\n".join(code for _, code in LIBRARY_STEPS) + "\n"
+STEPS = """\
+import json, sys, time
+steps = json.loads(sys.argv[1])
+out = []
+for code in steps:
+    start = time.process_time()
+    exec(code)
+    out.append(time.process_time() - start)
+print(json.dumps(out))
+"""
+
+
+def library_steps(repeat: int) -> None:
+    """CPU seconds of each library a small run imports, in turn in one fresh process (what
+    the earlier ones share is theirs), medians of ``repeat`` processes."""
+    import json
+
+    command = [sys.executable, "-c", STEPS, json.dumps([code for _, code in LIBRARY_STEPS])]
+    subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)  # byte code
+    python = [timed_run([sys.executable, "-c", "pass"])[1] for _ in range(repeat)]
+    runs = [json.loads(timed_run(command)[2].stdout) for _ in range(repeat)]
+    print("| library (imported in this order, one process) | CPU s |")
+    print("|---|---|")
+    print(f"| starting Python | {statistics.median(python):.3f} |")
+    for k, (label, _) in enumerate(LIBRARY_STEPS):
+        print(f"| {label} | {statistics.median(r[k] for r in runs):.3f} |")
+    print(f"| all of them | {statistics.median(sum(r) for r in runs):.3f} |")
 
 
 def libraries_alone(folder: Path, repeat: int) -> tuple[float, float]:
@@ -123,11 +179,14 @@ import json, os, sys, time
 clocks = lambda: (time.perf_counter(), time.process_time())
 started = clocks()
 from vares.app.cli import main
+typer_imported = clocks()
 import vares.app.cli.pattern  # the subcommand's module, as main() imports it
 imported = clocks()
 from vares.app import outputs, runner
+from vares.app.cli import common
 from vares.solver import api
 phases = {}
+marks = {}
 
 def timed(name, function):
     def call(*args, **kwargs):
@@ -140,6 +199,15 @@ def timed(name, function):
             phases[name] = (wall + end[0] - start[0], cpu + end[1] - start[1])
     return call
 
+pattern = vares.app.cli.pattern
+job_from_flags = pattern.job_from_flags
+
+def first_job(*args, **kwargs):  # typer has parsed and coerced the arguments by now
+    marks.setdefault("parsed", clocks())
+    return job_from_flags(*args, **kwargs)
+
+pattern.job_from_flags = timed("job", first_job)
+common.show = timed("printing the summary", common.show)
 runner.load_input = timed("read", runner.load_input)
 runner._solve = timed("solve", runner._solve)
 api._load_kernels = timed("loading the kernels", api._load_kernels)
@@ -149,11 +217,14 @@ outputs._write = lambda panel, name, writer: timed(name, write)(panel, name, wri
 sys.argv = ["vares", "pattern", *sys.argv[1:]]
 end = os._exit
 os._exit = lambda code: None  # the command ends the process itself: print first, then end
+called = clocks()
 try:
     main()
 except SystemExit:
     pass
-phases["import"] = (imported[0] - started[0], imported[1] - started[1])
+phases["typer"] = (typer_imported[0] - started[0], typer_imported[1] - started[1])
+phases["import"] = (imported[0] - typer_imported[0], imported[1] - typer_imported[1])
+phases["arguments"] = tuple(marks["parsed"][i] - called[i] for i in range(2))
 done = clocks()
 phases["command"] = (done[0] - started[0], done[1] - started[1])
 print(json.dumps(phases), flush=True)
@@ -161,25 +232,29 @@ end(0)
 """
 
 
-def timed_run(command: list[str]) -> tuple[float, float, subprocess.CompletedProcess]:
+def timed_run(
+    command: list[str], environment: dict[str, str] | None = None
+) -> tuple[float, float, subprocess.CompletedProcess]:
     """Wall and CPU seconds (user + system, the operating system's own count) of a fresh
     process, and what it printed."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    done = subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)
+    done = subprocess.run(command, check=True, capture_output=True, env=environment or ENVIRONMENT)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
     return wall, cpu, done
 
 
-def breakdown(path: Path, folder: Path, repeat: int) -> None:
+def breakdown(path: Path, folder: Path, repeat: int, quiet: bool = True) -> None:
     """The phases of a default run, wall and CPU seconds, medians of ``repeat`` fresh
-    processes (on a loaded machine the CPU seconds are the steadier figure)."""
+    processes (on a loaded machine the CPU seconds are the steadier figure); ``quiet``: with
+    ``-q``, else printing its progress and summary as a user sees them (to a pipe)."""
     script = folder / "breakdown.py"
     script.write_text(BREAKDOWN)
     out = folder / "breakdown"
-    command = [sys.executable, str(script), str(path), "-o", str(out), "--force", "-q"]
+    command = [sys.executable, str(script), str(path), "-o", str(out), "--force"]
+    command += ["-q"] if quiet else []
     subprocess.run(command, check=True, capture_output=True, env=ENVIRONMENT)  # warm
     python = [sys.executable, "-c", "pass"]
     rows: list[dict[str, tuple[float, float]]] = []
@@ -200,14 +275,17 @@ def breakdown(path: Path, folder: Path, repeat: int) -> None:
             phases["whole process"][i] - alone[i] - phases["command"][i] for i in range(2)
         )
         rows.append(phases)
-    order = ["whole process", "starting Python", "import", "read", "loading the kernels"]
-    order += ["solve"]
+    order = ["whole process", "starting Python", "typer", "import", "arguments", "job", "read"]
+    order += ["loading the kernels", "solve"]
     order += [k for k in rows[0] if k not in {*order, "command", "the rest", "exit"}]
     order += ["the rest", "exit"]
     names = {
-        "import": "importing the command line",
+        "typer": "importing typer (the command line's entry)",
+        "import": "importing the subcommand (numpy, scipy.sparse, the options)",
+        "arguments": "parsing the arguments (typer: pydantic's import, an adapter a parameter)",
+        "job": "the job from the flags (options checked)",
         "read": "reading and checking the mesh",
-        "the rest": "the rest of the command (arguments, options, checks, staging folder)",
+        "the rest": "the rest of the command (checks, staging folder, moving it into place)",
         "exit": "ending the process, and what the clocks saw outside the command",
     }
     print("| phase | wall s | CPU s |")
@@ -217,6 +295,31 @@ def breakdown(path: Path, folder: Path, repeat: int) -> None:
         cpu = statistics.median(r[key][1] for r in rows)
         print(f"| {names.get(key, key)} | {wall:.3f} | {cpu:.3f} |")
     importtime(command, repeat)
+
+
+def side_by_side(path: Path, folder: Path, against: str, repeat: int) -> None:
+    """A default run of this tree's code (PYTHONPATH as given) and of the tree whose sources
+    are at ``against`` (PYTHONPATH=against), in turn, ``repeat`` pairs: medians of the wall and
+    CPU seconds of each, and of their ratio pair by pair (with its range)."""
+    command = [vares_script(), "pattern", str(path), "-o", str(folder / "pair"), "--force"]
+    variants = {"this tree": dict(ENVIRONMENT), "against": dict(ENVIRONMENT, PYTHONPATH=against)}
+    for environment in variants.values():  # byte code written, first
+        subprocess.run(command, check=True, capture_output=True, env=environment)
+    runs: dict[str, list[tuple[float, float]]] = {name: [] for name in variants}
+    for _ in range(repeat):
+        for name, environment in variants.items():
+            runs[name].append(timed_run(command, environment)[:2])
+    print(f"| `vares pattern` ({repeat} pairs, in turn) | wall s | CPU s |")
+    print("|---|---|---|")
+    for name, figures in runs.items():
+        wall = statistics.median(r[0] for r in figures)
+        cpu = statistics.median(r[1] for r in figures)
+        print(f"| {name if name != 'against' else against} | {wall:.3f} | {cpu:.3f} |")
+    for k, label in enumerate(("wall", "CPU")):
+        ratios = [a[k] / b[k] for a, b in zip(runs["this tree"], runs["against"], strict=True)]
+        spread = f"{min(ratios):.3f}–{max(ratios):.3f}"
+        print(f"| ratio, {label} (pair by pair: median, min–max) | "
+              f"{statistics.median(ratios):.3f} | {spread} |")  # fmt: skip
 
 
 def importtime(command: list[str], repeat: int) -> None:
@@ -255,18 +358,34 @@ def main() -> None:
     parser.add_argument("--breakdown", action="store_true", help="phase by phase, one size")
     parser.add_argument("--no-bytecode", action="store_true", help="compile every module anew")
     parser.add_argument(
+        "--no-quiet", action="store_true", help="breakdown: printing as a user sees it (no -q)"
+    )
+    parser.add_argument(
+        "--libraries", action="store_true", help="each library a small run imports, its CPU"
+    )
+    parser.add_argument(
+        "--against",
+        metavar="SRC",
+        help="a default run side by side with the sources at SRC (another tree's src/)",
+    )
+    parser.add_argument(
         "--first", action="store_true", help="also the first run after an install (no numba cache)"
     )
     args = parser.parse_args()
     sizes = args.sizes or (["sail"] if args.breakdown else list(SIZES))
     flags = "".join(
         f" --{name.replace('_', '-')}"
-        for name in ("breakdown", "no_bytecode", "first")
+        for name in ("breakdown", "no_bytecode", "first", "no_quiet", "libraries")
         if getattr(args, name)
-    )
+    ) + (f" --against {args.against}" if args.against else "")
     print(f"# python benchmarks/around_the_solve.py --repeat {args.repeat} --sizes "
           f"{' '.join(sizes)}{flags}")  # fmt: skip
-    if args.breakdown:
+    if args.libraries:
+        with tempfile.TemporaryDirectory() as folder:
+            set_bytecode(not args.no_bytecode, Path(folder))
+            library_steps(args.repeat)
+        return
+    if args.breakdown or args.against:
         with tempfile.TemporaryDirectory() as folder:
             folder = Path(folder)
             set_bytecode(not args.no_bytecode, folder)
@@ -275,7 +394,10 @@ def main() -> None:
             path = folder / f"{sizes[0]}.obj"
             meshio.write(path, meshio.Mesh(mesh.points, list(mesh.cells.items())))
             print(f"{label}, default outputs")
-            breakdown(path, folder, args.repeat)
+            if args.against:
+                side_by_side(path, folder, args.against, args.repeat)
+            if args.breakdown:
+                breakdown(path, folder, args.repeat, quiet=not args.no_quiet)
         return
     print("| surface | variant | whole command s | CPU s | solve s | rest s |")
     print("|---|---|---|---|---|---|")
