@@ -25,7 +25,7 @@ from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
 from ..solver import IterationRecord, SolveOptions
 from ..units import unit_factor
-from .layout import CELLS_ACROSS, StripPlan, plan_strips, strips_along_lines
+from .layout import CELLS_ACROSS, StripPlan, longest_edge_for, plan_strips, strips_along_lines
 from .matching import StructureResult, solve_structure
 from .nesting import RollNest, nest_pieces, usable_width
 from .options import CutOptions, StructureOptions
@@ -104,16 +104,16 @@ class CutResult:
         plan, notes = self.plan, []
         if plan.refinements:
             rounds = "round" if plan.refinements == 1 else "rounds"
+            strip = (
+                "a strip of a pair, about half as wide as the roll,"
+                if plan.interlock
+                else "a strip as wide as the roll"
+            )
             notes.append(
                 f"the surface was refined on its own faces ({plan.refinements} {rounds} of "
                 f"midpoint subdivision, {plan.input_cells:,} → {plan.refined_cells:,} triangles) "
-                f"so that a strip as wide as the roll is at least {CELLS_ACROSS} cells across"
-                + (
-                    " (a strip of a pair, about half as wide, about half as many)"
-                    if plan.interlock
-                    else ""
-                )
-                + "; its shape and area are unchanged"
+                f"so that {strip} is at least {CELLS_ACROSS} cells across; its shape and area "
+                "are unchanged"
             )
         if plan.replaced_geodesics:
             notes.append(
@@ -359,7 +359,7 @@ def _plan(
     if cutting.seams == "curves":
         from ..geometry.drawn_lines import curves_on_surface
 
-        fine, rounds = refine(surface, target / CELLS_ACROSS)
+        fine, rounds = refine(surface, longest_edge_for(target))
         base, on_surface = curves_on_surface(fine, lines, cutting.snap)
         plan = strips_along_lines(base, on_surface, cutting.snap, options.warp_direction)
         plan.refinements, plan.input_cells = rounds, len(surface.cells["triangle"])

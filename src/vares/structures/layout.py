@@ -18,7 +18,8 @@ plane section, and so on until all lines keep apart: plane sections of different
 never meet.
 
 A design mesh is often coarser than the strips: the surface is refined on its own faces first
-(:mod:`vares.geometry.refine`) until no edge is longer than the roll width / ``CELLS_ACROSS``;
+(:mod:`vares.geometry.refine`) until no edge is longer than the roll width / ``CELLS_ACROSS``
+(half that for strips in pairs, each about half the roll wide: :func:`longest_edge_for`);
 if lines still meet where their crossings were moved onto the same node, it is refined further.
 
 The flattened width is an estimate of the pattern's: :func:`vares.structures.cut.cut` checks the
@@ -52,6 +53,7 @@ __all__ = [
     "MAX_REFINED_CELLS",
     "SEAM_KINDS",
     "StripPlan",
+    "longest_edge_for",
     "pattern_direction",
     "plan_strips",
     "strips_along_lines",
@@ -109,14 +111,14 @@ def plan_strips(
             raise CuttingError(f"more than {max_strips} strips would be needed")
     # in pairs two strips share the width, each about half of it
     strips = f"strips in pairs {width:g} wide" if interlock else f"strips of {width:g}"
-    cells = refined_cells(surface, width / CELLS_ACROSS)
+    longest = longest_edge_for(width, interlock)
+    cells = refined_cells(surface, longest)
     if cells > MAX_REFINED_CELLS:
         raise CuttingError(
             f"{strips} would need the surface refined to about {cells:,.0f} cells "
-            f"(edges of at most {width / CELLS_ACROSS:g}; at most {MAX_REFINED_CELLS:,}): try a "
-            "wider roll"
+            f"(edges of at most {longest:g}; at most {MAX_REFINED_CELLS:,}): try a wider roll"
         )
-    refined = _Refined(surface, width, strips)
+    refined = _Refined(surface, width, longest, strips)
 
     def evaluate(spans: np.ndarray) -> tuple[StripPlan, np.ndarray]:
         plan = refined.layout(family, spans, seams, snap, warp_direction)
@@ -168,6 +170,13 @@ def plan_strips(
     return plan
 
 
+def longest_edge_for(width: float, interlock: bool = False) -> float:
+    """The longest edge the surface may have for strips planned on a roll ``width`` wide: a
+    strip as wide as the roll is :data:`CELLS_ACROSS` cells across; a strip of a pair
+    (``interlock``) is about half as wide, and as many cells across."""
+    return width / CELLS_ACROSS / (2.0 if interlock else 1.0)
+
+
 def refined_cells(surface: SurfaceMesh, longest: float) -> float:
     """About how many triangles the triangle mesh ``surface`` has once refined on its own faces
     until no edge is longer than ``longest`` (each halving of a cell's longest edge a 1-to-4
@@ -182,12 +191,12 @@ def refined_cells(surface: SurfaceMesh, longest: float) -> float:
 
 class _Refined:
     """The surface the lines are placed on: refined on its own faces until its edges are at most
-    ``width / CELLS_ACROSS`` long, and further (each time halving that length; ``_RETRIES``
-    times at most for the whole plan) when planned lines meet; then plane sections in place of
-    geodesics where they still do."""
+    ``longest`` (:func:`longest_edge_for` the roll ``width``), and further (each time halving
+    that length; ``_RETRIES`` times at most for the whole plan) when planned lines meet; then
+    plane sections in place of geodesics where they still do."""
 
-    def __init__(self, surface: SurfaceMesh, width: float, strips: str) -> None:
-        self.width, self.longest, self.strips = width, width / CELLS_ACROSS, strips
+    def __init__(self, surface: SurfaceMesh, width: float, longest: float, strips: str) -> None:
+        self.width, self.longest, self.strips = width, longest, strips
         self.surface, self.rounds = refine(surface, self.longest)
         self.retries = _RETRIES
 
