@@ -396,3 +396,35 @@ def test_planned_lines_that_meet_refine_the_surface_then_become_plane_sections(m
     assert plan.refinements == 2 and plan.replaced_geodesics == len(plan.lines)
     assert plan.refined_cells == 16 * len(mesh.cells["triangle"])
     assert {"geodesic", "planar"} <= {seams for seams, _ in calls}
+
+
+def test_a_coarse_ring_of_facets_is_cut_all_round():
+    """A coarse design of the conic tent (16 facets round: its nodes' azimuths 22.5° apart) goes
+    all round its axis, as its high ring's boundary loop does: radial strips all round, that fit
+    the roll, the least number that does."""
+    from vares.geometry.example_surfaces import tent_roof
+
+    tent = triangulated(tent_roof(n_radial=3, n_around=4))
+    assert tent.num_cells == 96
+    family = line_family(tent)
+    assert family.kind == "radial" and family.closed
+    assert family.span[1] - family.span[0] == pytest.approx(2 * np.pi)
+    plan = plan_strips(tent, 2.5, max_strips=40)
+    assert max(plan.widths) <= 2.5 and len(plan.panels) == 15
+    assert dict(plan.history)[14] > 2.5
+    assert sum(p.mesh.area for p in plan.panels) == pytest.approx(tent.area, rel=1e-12)
+
+
+def test_strips_in_pairs_are_refined_for_their_own_width():
+    """Strips planned in pairs are each about half as wide as the roll: the surface is refined
+    so that they, not a roll-wide strip, are ``CELLS_ACROSS`` cells across."""
+    from vares.geometry.example_surfaces import tent_roof
+
+    tent = triangulated(tent_roof(n_radial=3, n_around=4))
+    alone = plan_strips(tent, 4.0)
+    paired = plan_strips(tent, 4.0, interlock=True)
+    assert paired.interlock and max(paired.widths) <= 4.0
+    assert longest_edge(alone.cut.mesh) <= 4.0 / CELLS_ACROSS
+    assert longest_edge(alone.cut.mesh) > 4.0 / (2 * CELLS_ACROSS)  # no finer than it needs
+    assert longest_edge(paired.cut.mesh) <= 4.0 / (2 * CELLS_ACROSS)
+    assert paired.refinements == alone.refinements + 1

@@ -126,7 +126,7 @@ def line_family(
     angle = np.sort(np.arctan2(points[:, 1] - centre[1], points[:, 0] - centre[0]))
     gaps = np.diff(np.concatenate([angle, [angle[0] + 2 * np.pi]]))
     widest = int(np.argmax(gaps))
-    closed = bool(gaps[widest] < np.pi / 8)
+    closed = bool(gaps[widest] < np.pi / 8) or _goes_round(mesh, centre)
     if closed:
         start = float(angle[0])
         span = (start, start + 2 * np.pi)
@@ -134,6 +134,21 @@ def line_family(
         start = float(angle[(widest + 1) % len(angle)])
         span = (start, start + 2 * np.pi - float(gaps[widest]))
     return LineFamily("radial", normal, np.array([0.0, 0.0, 1.0]), centre, span, closed)
+
+
+def _goes_round(mesh: SurfaceMesh, centre: np.ndarray) -> bool:
+    """Whether a boundary loop of ``mesh`` winds round the vertical axis through ``centre``
+    (in plan): the surface then goes all round it, however few nodes it has round (a coarse
+    design's ring of 16 facets leaves gaps of 22.5° between its nodes' azimuths)."""
+    for loop in mesh.boundary_loops():
+        xy = mesh.points[loop, :2] - centre[:2]
+        radius = np.linalg.norm(xy, axis=1)
+        if radius.min() <= 1e-9 * max(float(radius.max()), 1e-300):
+            continue  # the axis passes through the loop: it winds round nothing
+        turn = np.diff(np.arctan2(xy[:, 1], xy[:, 0]), append=np.arctan2(xy[0, 1], xy[0, 0]))
+        if abs(float(np.sum((turn + np.pi) % (2 * np.pi) - np.pi))) > np.pi:
+            return True
+    return False
 
 
 def _high_point(mesh: SurfaceMesh) -> tuple[np.ndarray, bool]:
