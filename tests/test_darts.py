@@ -62,6 +62,31 @@ def test_a_walked_line_is_straight_and_as_long_as_asked():
     assert through.points[-1, 1] < 1.0 and through.points[-1, 1] > 0.85
 
 
+def test_a_walk_that_turns_back_stops_before_a_face_it_crossed():
+    """A direction field that sends the walk back the way it came (a bisector whose sign flips
+    from cell to cell) ends the line before it re-enters a face: without that check the walk
+    went back and forth across one side for its 100,000 steps, a line of 100,001 points."""
+    mesh = square(10)
+    turns = []
+
+    def back_and_forth(face, here, last):
+        turns.append(face)
+        return np.array([0.0, 1.0, 0.0]) if len(turns) % 2 else np.array([0.0, -1.0, 0.0])
+
+    line = straight_up(mesh, 0.43, 0.05)  # the start: a point on the bottom edge
+    triangles = mesh.cells["triangle"]
+    face = int(np.flatnonzero(np.isin(triangles, line.ends[0]).sum(axis=1) == 2)[0])
+    weights = np.zeros(3)
+    a, b = line.ends[0]
+    weights[triangles[face] == a], weights[triangles[face] == b] = (
+        1 - line.fractions[0],
+        line.fractions[0],
+    )
+    walked = walk_line(mesh, face, weights, back_and_forth, 10.0)
+    assert len(walked.points) <= 3 and len(turns) <= 3
+    assert np.all(np.linalg.norm(np.diff(walked.points, axis=0), axis=1) > 0)
+
+
 def test_an_opened_slit_frees_both_lips_and_keeps_the_surface():
     mesh = square(10)
     line = straight_up(mesh, 0.43, 0.5)

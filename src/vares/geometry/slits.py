@@ -46,8 +46,10 @@ def walk_line(
     In every face the walk goes straight along ``direction(face, point, last)`` projected onto
     the face to the side it leaves by, and on into the face across it; it ends where
     ``direction`` returns None, before the mesh's boundary, or after ``max_length`` (mesh
-    units). The line holds the start (when it lies on an edge) and every edge crossing but one
-    onto the boundary; where the walk ends inside a face, its last crossing is the line's end.
+    units), or before it would enter a face it has crossed already (a direction field that
+    turns the walk back on itself: a slit must not cross itself). The line holds the start
+    (when it lies on an edge) and every edge crossing but one onto the boundary; where the walk
+    ends inside a face, its last crossing is the line's end.
     """
     triangles = check_triangles(mesh)
     points = mesh.points
@@ -63,6 +65,7 @@ def walk_line(
         fractions.append(float(w[(k + 2) % 3] / (w[(k + 1) % 3] + w[(k + 2) % 3])))
     last: np.ndarray | None = None
     length = 0.0
+    visited = {int(face)}
     for _ in range(max_steps):
         corners = points[triangles[face]]
         here = w @ corners
@@ -86,12 +89,13 @@ def walk_line(
             exit_weights[(k + 2) % 3] / (exit_weights[(k + 1) % 3] + exit_weights[(k + 2) % 3])
         )
         following = int(neighbours[face, k])
-        if following < 0:  # the line ends inside the surface, before the boundary
-            break
+        if following < 0 or following in visited:
+            break  # before the boundary, or before a face crossed already (turning back)
         ends.append((a, b))
         fractions.append(t)
         if length >= max_length:
             break
+        visited.add(following)
         corners_next = triangles[following]
         w = np.zeros(3)
         w[int(np.flatnonzero(corners_next == a)[0])] = 1.0 - t
