@@ -38,7 +38,11 @@ factorised tangent, and only as accurately as the test of its objective needs
 is erected to the full tolerance at the end. It stops when a step lowers ``J`` (or the
 Gauss–Newton model promises to lower it) by less than ``tolerance`` of it, when nothing is left
 above round-off, or after ``optimise_iterations`` steps. Patterns stay one-to-one (a step that
-inverts a pattern cell is refused like one that raises ``J``).
+inverts a pattern cell is refused like one that raises ``J``). The shape bound is held, not
+only penalised (:mod:`vares.analysis.erection_bound`): nodes at the bound that a step would move
+outwards are held there (the step solved again on the null space of their linearised
+constraints), each step is cut where its linearised deviations reach the bound, and a trial
+beyond it is refused.
 """
 
 from __future__ import annotations
@@ -56,6 +60,7 @@ from ..options import split_settings, takes_options
 from ..solver.linear import quiet_blas
 from ..solver.options import SolveOptions
 from .erection import erect
+from .erection_bound import AT_BOUND, HeldNodes, ShapeBound
 from .erection_model import Pattern, patterns_of
 from .erection_optimum_result import OptimisedPatterns, OptimumRecord, optimised_results
 from .erection_residuals import (
@@ -85,6 +90,9 @@ MIN_STEP_STRAIN = 1e-4
 #: tolerance (of ``J``) ends the optimisation before its trial is erected: its actual gain
 #: would not pass the tolerance either (the gains of the last steps are 0.25–0.95).
 PROMISED_GAIN = 1.0
+#: With a shape bound: how many times a step is solved again with more nodes held at the
+#: bound (:func:`_direction`).
+HOLD_PASSES = 2
 #: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
 LSQR_TOLERANCE = 1e-3
 LSQR_LIMIT = 15
@@ -171,7 +179,8 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
     floors = (FORCE_FLOOR * material.stiffness_scale * thickness, SHAPE_FLOOR * size)
     scales = (max(erected_rms(first), floors[0]), max(first.deviation()["rms"], floors[1]))
     negligible = ((floors[0] / scales[0]) ** 2, shape_weight * (floors[1] / scales[1]) ** 2)
-    bound = None if shape_bound is None else shape_bound * first.deviation()["max"]
+    held = None if shape_bound is None else ShapeBound(shape_bound * first.deviation()["max"])
+    bound = None if held is None else held.bound
 
     def model_of(p, e):
         return ResidualModel(p, e, layout, seams, scales, shape_weight, bound, solver.linear_solver)
@@ -192,16 +201,22 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
             break
         lsqr_its = 0
         if step is None:  # a new Levenberg–Marquardt step (after a refused one: shorter)
-            op = model.operator()
             if mu is None:
-                mu = INITIAL_DAMPING * _norm_squared(op)
+                mu = INITIAL_DAMPING * _norm_squared(model.operator())
                 preconditioner = stiffness_preconditioner(patterns, material, thickness)
-            step, lsqr_its = _lsqr(op, model, mu, preconditioner)
-            if len(seams):
-                step = model.projection()(step)  # seams kept matched to first order
-            step_strain = edge_strain(current, step, edges, layout)
+
+            def strain_of(v, at=current):
+                return edge_strain(at, v, edges, layout)
+
+            step, step_strain, lsqr_its = _direction(
+                model, mu, preconditioner, strain_of, held, radius
+            )
         scale = min(1.0, radius / step_strain) if step_strain > 0 else 1.0
         change, dx = model.response(scale * step)
+        if held is not None:  # cut where its linearised deviations reach the bound
+            moved_to = model.deviation_change(dx)
+            cut = held.largest_step(model.erected.normal_deviation, moved_to)
+            scale, change, dx = cut * scale, cut * change, cut * dx
         predicted = objective - float(np.sum((model.residual + change) ** 2))
         if predicted < PROMISED_GAIN * tolerance * objective:
             converged = True  # the model promises less than a step must gain
@@ -212,6 +227,9 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
             trial, material, thickness, loose, options, erected, model, dx
         )
         accepted, decrease, gain = False, 0.0, -1.0
+        if attempt is not None and held is not None:
+            if not held.admits(attempt.deviation()["max"], erected.deviation()["max"]):
+                attempt, held.refused = None, held.refused + 1  # beyond the bound: refused
         if attempt is not None:
             trial_model = model_of(trial, attempt)
             value = float(trial_model.residual @ trial_model.residual)
@@ -276,29 +294,62 @@ def _overlapping(patterns: list[Pattern]) -> str | None:
     return None
 
 
-def _lsqr(op, model, mu, preconditioner=None):
+def _direction(model, mu, preconditioner, strain_of, held=None, radius=None):
+    """A Levenberg–Marquardt step (seams kept matched to first order), its largest edge strain
+    and LSQR's iterations. With a bound ``held``: the nodes at the bound that the step (cut to
+    the trust region ``radius``) would move outwards by its linearised prediction are held where
+    they are (:class:`HeldNodes`: the step solved again on the null space of their constraints),
+    at most :data:`HOLD_PASSES` times; the step then slides along the bound."""
+    project = model.projection() if len(model.seams) else (lambda v: v)
+    d = model.erected.normal_deviation
+    at_bound = np.abs(d) >= (1.0 - AT_BOUND) * held.bound if held is not None else None
+    nodes, constraints, total = np.zeros(0, dtype=int), None, 0
+    for attempt in range(HOLD_PASSES + 1):
+        step, iterations = _lsqr(model.operator(), model.residual, mu, preconditioner, constraints)
+        total += iterations
+        step = project(step)
+        strain = strain_of(step)
+        if held is None or not at_bound.any() or attempt == HOLD_PASSES:
+            break
+        scale = min(1.0, radius / strain) if strain > 0 else 1.0
+        change = model.deviation_change(model.response(scale * step)[1]) - d
+        outwards = np.flatnonzero(at_bound & (np.sign(d) * change > 0))
+        outwards = outwards[~np.isin(outwards, nodes)]
+        if not len(outwards):
+            break
+        nodes = np.concatenate([nodes, outwards])
+        constraints = HeldNodes(model.deviation_gradients(nodes), project, preconditioner)
+    return step, strain, total
+
+
+def _lsqr(op, residual, mu, preconditioner=None, constraints=None):
     """The Levenberg–Marquardt step ``min |J Δ + r|² + μ |Δ|²`` (to LSQR's loose tolerance: the
     step is inexact) and LSQR's iterations; with a right ``preconditioner`` ``P`` (symmetric),
-    ``Δ = P y`` and LSQR solves for ``y`` the same problem, ``min |J P y + r|² + μ |P y|²``."""
+    ``Δ = P y`` and LSQR solves for ``y`` the same problem, ``min |J P y + r|² + μ |P y|²``;
+    with ``constraints`` (:class:`HeldNodes`), for ``y`` on their null space."""
     tol = LSQR_TOLERANCE
-    if preconditioner is None:
-        out = spla.lsqr(
-            op, -model.residual, damp=np.sqrt(mu), atol=tol, btol=tol, iter_lim=LSQR_LIMIT
-        )
+    if preconditioner is None and constraints is None:
+        out = spla.lsqr(op, -residual, damp=np.sqrt(mu), atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
         return out[0], out[2]
-    rows, root = len(model.residual), np.sqrt(mu)
+    rows, root = len(residual), np.sqrt(mu)
+
+    def metric(y):
+        y = y if constraints is None else constraints.project(y)
+        return y if preconditioner is None else preconditioner.matvec(y)
 
     def matvec(y):
-        step = preconditioner.matvec(y)
+        step = metric(y)
         return np.concatenate([op.matvec(step), root * step])
 
     def rmatvec(u):
-        return preconditioner.matvec(op.rmatvec(u[:rows]) + root * u[rows:])
+        v = op.rmatvec(u[:rows]) + root * u[rows:]
+        v = v if preconditioner is None else preconditioner.matvec(v)
+        return v if constraints is None else constraints.project(v)
 
     augmented = spla.LinearOperator((rows + op.shape[1], op.shape[1]), matvec, rmatvec, dtype=float)
-    rhs = np.concatenate([-model.residual, np.zeros(op.shape[1])])
+    rhs = np.concatenate([-residual, np.zeros(op.shape[1])])
     out = spla.lsqr(augmented, rhs, atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
-    return preconditioner.matvec(out[0]), out[2]
+    return metric(out[0]), out[2]
 
 
 def _norm_squared(op, iterations: int = 4) -> float:

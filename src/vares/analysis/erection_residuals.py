@@ -280,14 +280,8 @@ class ResidualModel:
         ).tocsc()[:, kept]
         least_X = sp.csr_matrix((cat(lX_vals), (cat(lX_rows), cat(lX_cols))), shape=(n_cells, nv))
         weights, normals = self._shape_rows
-        rows = np.repeat(np.arange(2 * n_nodes), 3)
-        shape_by_x = sp.csr_matrix(
-            (
-                (weights[:, None] * np.vstack([normals, normals])).ravel(),
-                (rows, np.tile(np.arange(3 * n_nodes), 2)),
-            ),
-            shape=(2 * n_nodes, 3 * n_nodes),
-        ).tocsc()[:, kept]
+        shape_by_x = shape_by_x_of(weights, normals, n_nodes)[:, kept]
+        self._normals_by_x = shape_by_x_of(np.ones(n_nodes), normals, n_nodes)[:, kept]
         self.by_X = sp.vstack([self._force_rows @ raw_X, wrinkle @ least_X]).tocsr()
         self.by_x = sp.vstack([self._force_rows @ raw_x, wrinkle @ least_x, shape_by_x]).tocsr()
         self._by_x_t = self.by_x.T.tocsr()
@@ -320,6 +314,18 @@ class ResidualModel:
         forces = self.by_X @ v + self.by_x[: self.num_force] @ dx
         shape = self.by_x[self.num_force :] @ dx
         return np.concatenate([forces, shape]), dx
+
+    def deviation_change(self, dx: np.ndarray) -> np.ndarray:
+        """The nodes' normal deviations moved by ``dx`` (free dofs), to first order."""
+        self.linearise()
+        return self.erected.normal_deviation + self._normals_by_x @ dx
+
+    def deviation_gradients(self, nodes: np.ndarray) -> np.ndarray:
+        """``∂d_i/∂X`` ``(k, num_variables)`` of the ``nodes``' normal deviations through the
+        erected equilibrium, ``−(∂R/∂X)ᵀ K⁻¹ n_i``: one solve with ``K`` each."""
+        self.linearise()
+        rows = self._normals_by_x[nodes].toarray()
+        return np.array([-(self._mixed_t @ self._tangent_solve(r)) for r in rows])
 
     def matvec(self, v: np.ndarray) -> np.ndarray:
         """``J v``: the residuals' change for a change ``v`` of the patterns."""
@@ -364,6 +370,20 @@ class ResidualModel:
             self._gram = gram
             self._projection = lambda v: v - C.T @ gram.solve(C @ v)
         return self._projection
+
+
+def shape_by_x_of(weights: np.ndarray, normals: np.ndarray, n_nodes: int) -> sp.csc_matrix:
+    """The rows ``weights_i n_i`` ``(len(weights), 3 n_nodes)``: the derivatives of weighted
+    normal deviations by the positions (the weights of ``len(weights) / n_nodes`` row sets)."""
+    sets = len(weights) // n_nodes
+    rows = np.repeat(np.arange(len(weights)), 3)
+    return sp.csr_matrix(
+        (
+            (weights[:, None] * np.vstack([normals] * sets)).ravel(),
+            (rows, np.tile(np.arange(3 * n_nodes), sets)),
+        ),
+        shape=(len(weights), 3 * n_nodes),
+    ).tocsc()
 
 
 def stiffness_preconditioner(

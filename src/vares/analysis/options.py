@@ -96,8 +96,10 @@ class ErectionOptions(Options):
     shape_bound: float | None = option(
         1.5,
         "float",
-        "With --optimise: the largest deviation from the design allowed, relative to the VaReS "
-        "patterns' erection (a node beyond it is penalised heavily; none in the API: no bound).",
+        "With --optimise: the largest normal deviation from the design allowed (a node's "
+        "displacement along the design's normal, as erect.json's deviation max), relative to "
+        "the VaReS patterns' erection; it holds to 0.5 % of itself (steps are cut at it and a "
+        "trial beyond it is refused; none in the API: no bound).",
         section="erection",
         positive=True,
         optional=True,
