@@ -45,17 +45,27 @@ from pathlib import Path
 
 import numpy as np
 
-from vares.analysis.darts import solve_with_darts
+from vares.analysis.darts import smoothed, solve_with_darts
 from vares.analysis.drape import drape_ply
 from vares.geometry.cutting import cut_mesh
 from vares.geometry.examples import double_dome, double_dome_height, irregular_cap, rib30
 from vares.geometry.surface_lines import EdgeLocator
 from vares.materials import NonCrimpFabric, OrthotropicStVenantKirchhoff
+from vares.materials.shear_locking import locking_fabric
+
+#: The stiffness of the locking laws at 50° (``--locking-stiffness``, times the shear modulus 1).
+LOCKING_STIFFNESS = [100.0]
 
 LAWS = {
     "ncf": lambda: NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5]),
     "ncf-stiffening": lambda: NonCrimpFabric(
         [-250.0, 250.0], [-250.0, 250.0], [0.5, 0.0, 0.0, 0.0, 0.0, 200.0]
+    ),
+    "ncf-locking": lambda: locking_fabric(
+        [-250.0, 250.0], [-250.0, 250.0], [0.5], 50.0, LOCKING_STIFFNESS[0]
+    ),
+    "ncf-stiff-locking": lambda: locking_fabric(
+        [-2500.0, 2500.0], [-2500.0, 2500.0], [0.5], 50.0, LOCKING_STIFFNESS[0]
     ),
     "woven": lambda: OrthotropicStVenantKirchhoff(E1=1e4, E2=1e4, G12=1.0, nu12=0.0),
 }
@@ -123,7 +133,19 @@ def main() -> None:
     parser.add_argument("--radial", type=float, nargs="+", help="given darts' ends (mm)")
     parser.add_argument("--ray-angle", type=float, default=36.9, help="their rays (degrees)")
     parser.add_argument("--mirrored", type=float, nargs="+", help="tip angles (degrees)")
+    parser.add_argument("--side", type=float, nargs="+", help="side darts' plan depths (mm)")
+    parser.add_argument("--side-x", type=float, nargs="+", default=[55.0], help="their x (mm)")
+    parser.add_argument(
+        "--locking-stiffness", type=float, default=100.0, help="locking laws' stiffness at 50°"
+    )
     args = parser.parse_args()
+    LOCKING_STIFFNESS[0] = args.locking_stiffness
+    if args.side:
+        for size in args.cell_size:
+            for law in args.law:
+                for depth in args.side:
+                    side(size, law, args.locking[0], depth, args.side_x)
+        return
     if args.mirrored:
         for size in args.cell_size:
             mirrored(size, args.law, args.locking[0], args.mirrored)
@@ -243,6 +265,28 @@ def radial(cell_size: float, law: str, locking: float, end: float, angle: float)
     quadrants(darted)
 
 
+def side(cell_size: float, law: str, locking: float, depth: float, xs: list[float]) -> None:
+    """Given darts on the double dome from its long sides: at every ``x`` of ``xs`` and its
+    mirror image, from the outline along ∓y (across the warp), ``depth`` mm in the plan
+    (module docs)."""
+    mesh, warp = mould("double-dome", 0, cell_size)
+    a, b = 155.0, 100.0  # the outline's half-lengths
+    lines = []
+    for x in sorted({*xs, *(-v for v in xs)}):
+        for sy in (1.0, -1.0):
+            y0 = sy * b * np.sqrt(1.0 - (x / a) ** 2)
+            y = y0 - sy * np.linspace(0.0, depth, 300)
+            inside = (x / a) ** 2 + (y / b) ** 2 < 0.999
+            xy = np.column_stack([np.full(inside.sum(), x), y[inside]])
+            lines.append(np.column_stack([xy, double_dome_height(xy[:, 0], xy[:, 1])]))
+    darted, text = given(mesh, law, locking, lines, warp)
+    print(
+        f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, {len(lines)} darts from the "
+        f"sides at x = ±{', ±'.join(f'{v:g}' for v in xs)}, {depth:g} mm deep: {text}"
+    )
+    quadrants(darted)
+
+
 def mirrored(cell_size: float, laws: list[str], locking: float, tips: list[float]) -> None:
     """Symmetric darts on the double dome: the first automatic dart of the plain ``ncf``
     pattern at each tip angle, mirrored across x = 0 and y = 0 (module docs)."""
@@ -301,14 +345,23 @@ def quadrants(darted) -> None:
         strain = np.maximum(
             np.abs(fields["warp_stretch"] - 1.0), np.abs(fields["fill_stretch"] - 1.0)
         )
+        mean = np.maximum(
+            np.abs(smoothed(result.mesh, fields["warp_stretch"] - 1.0)),
+            np.abs(smoothed(result.mesh, fields["fill_stretch"] - 1.0)),
+        )
         areas = result.mesh.cell_areas()
+        beyond = areas[shear >= darted.locking_angle].sum() / areas.sum()
         shares = [100 * areas[strain > limit].sum() / areas.sum() for limit in (0.01, 0.02, 0.05)]
+        means = [100 * areas[mean > limit].sum() / areas.sum() for limit in (0.005, 0.01, 0.02)]
         print(
             f"  {name}: largest shear per quadrant (+,+) (-,+) (-,-) (+,-): "
             + ", ".join(f"{v:.2f}°" for v in largest)
+            + f", {100 * beyond:.2f} % of the area at or beyond {darted.locking_angle:g}°"
             + "; yarn strain beyond 1, 2, 5 %: "
             + ", ".join(f"{v:.2f} %" for v in shares)
-            + f" of the area, largest {100 * strain.max():.2f} %"
+            + f" of the area, largest {100 * strain.max():.2f} %; nodal mean beyond 0.5, 1, 2 %: "
+            + ", ".join(f"{v:.2f} %" for v in means)
+            + f", largest {100 * mean.max():.2f} %"
         )
 
 
