@@ -98,8 +98,8 @@ class ErectionOptions(Options):
         "float",
         "With --optimise: the largest normal deviation from the design allowed (a node's "
         "displacement along the design's normal, as erect.json's deviation max), relative to "
-        "the VaReS patterns' erection; it holds to 0.5 % of itself (steps are cut at it and a "
-        "trial beyond it is refused; none in the API: no bound).",
+        "the VaReS patterns' erection; it holds to 0.5 % of itself (nodes at it are held there, "
+        "steps cut at it, a trial beyond it refused; none in the API: no bound).",
         section="erection",
         positive=True,
         optional=True,
