@@ -40,6 +40,7 @@ planes of symmetry: a symmetric set of four, opened on every ``--law``.)
 from __future__ import annotations
 
 import argparse
+import itertools
 import time
 from pathlib import Path
 
@@ -48,27 +49,33 @@ import numpy as np
 from vares.analysis.darts import smoothed, solve_with_darts
 from vares.analysis.drape import drape_ply
 from vares.geometry.cutting import cut_mesh
+from vares.geometry.double_dome import side_darts
 from vares.geometry.examples import double_dome, double_dome_height, irregular_cap, rib30
 from vares.geometry.surface_lines import EdgeLocator
 from vares.materials import NonCrimpFabric, OrthotropicStVenantKirchhoff
 from vares.materials.shear_locking import locking_fabric
 
-#: The stiffness of the locking laws at 50° (``--locking-stiffness``, times the shear modulus 1).
-LOCKING_STIFFNESS = [100.0]
+
+def locking_laws(stiffness: float) -> dict:
+    """The laws that lock at 50° with ``stiffness`` (× the shear modulus 1) there
+    (``--locking-stiffness``): the non-crimp fabric's yarns, and yarns ten times stiffer."""
+    return {
+        "ncf-locking": lambda: locking_fabric(
+            [-250.0, 250.0], [-250.0, 250.0], [0.5], 50.0, stiffness
+        ),
+        "ncf-stiff-locking": lambda: locking_fabric(
+            [-2500.0, 2500.0], [-2500.0, 2500.0], [0.5], 50.0, stiffness
+        ),
+    }
+
 
 LAWS = {
     "ncf": lambda: NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5]),
     "ncf-stiffening": lambda: NonCrimpFabric(
         [-250.0, 250.0], [-250.0, 250.0], [0.5, 0.0, 0.0, 0.0, 0.0, 200.0]
     ),
-    "ncf-locking": lambda: locking_fabric(
-        [-250.0, 250.0], [-250.0, 250.0], [0.5], 50.0, LOCKING_STIFFNESS[0]
-    ),
-    "ncf-stiff-locking": lambda: locking_fabric(
-        [-2500.0, 2500.0], [-2500.0, 2500.0], [0.5], 50.0, LOCKING_STIFFNESS[0]
-    ),
     "woven": lambda: OrthotropicStVenantKirchhoff(E1=1e4, E2=1e4, G12=1.0, nu12=0.0),
-}
+} | locking_laws(100.0)
 
 
 def mould(name: str, rings: int, cell_size: float = 5.0):
@@ -139,22 +146,18 @@ def main() -> None:
         "--locking-stiffness", type=float, default=100.0, help="locking laws' stiffness at 50°"
     )
     args = parser.parse_args()
-    LOCKING_STIFFNESS[0] = args.locking_stiffness
+    LAWS.update(locking_laws(args.locking_stiffness))
     if args.side:
-        for size in args.cell_size:
-            for law in args.law:
-                for depth in args.side:
-                    side(size, law, args.locking[0], depth, args.side_x)
+        for size, law, depth in itertools.product(args.cell_size, args.law, args.side):
+            side(size, law, args.locking[0], depth, args.side_x)
         return
     if args.mirrored:
         for size in args.cell_size:
             mirrored(size, args.law, args.locking[0], args.mirrored)
         return
     if args.radial:
-        for size in args.cell_size:
-            for law in args.law:
-                for end in args.radial:
-                    radial(size, law, args.locking[0], end, args.ray_angle)
+        for size, law, end in itertools.product(args.cell_size, args.law, args.radial):
+            radial(size, law, args.locking[0], end, args.ray_angle)
         return
     if args.turned:
         for rings in args.rings:
@@ -270,15 +273,7 @@ def side(cell_size: float, law: str, locking: float, depth: float, xs: list[floa
     mirror image, from the outline along ∓y (across the warp), ``depth`` mm in the plan
     (module docs)."""
     mesh, warp = mould("double-dome", 0, cell_size)
-    a, b = 155.0, 100.0  # the outline's half-lengths
-    lines = []
-    for x in sorted({*xs, *(-v for v in xs)}):
-        for sy in (1.0, -1.0):
-            y0 = sy * b * np.sqrt(1.0 - (x / a) ** 2)
-            y = y0 - sy * np.linspace(0.0, depth, 300)
-            inside = (x / a) ** 2 + (y / b) ** 2 < 0.999
-            xy = np.column_stack([np.full(inside.sum(), x), y[inside]])
-            lines.append(np.column_stack([xy, double_dome_height(xy[:, 0], xy[:, 1])]))
+    lines = side_darts(xs, depth)
     darted, text = given(mesh, law, locking, lines, warp)
     print(
         f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, {len(lines)} darts from the "

@@ -202,26 +202,13 @@ def test_the_example_command_refuses_quads_in_one_line(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def side_darts(x: float, depth: float) -> list[np.ndarray]:
-    """Four dart lines from the mould's long sides at ``±x``, ``depth`` mm into the plan along
-    ∓y (across the warp), on the surface (as ``benchmarks/darts.py --side``)."""
-    a, b = 155.0, 100.0  # the outline's half-lengths
-    lines = []
-    for sx in (1.0, -1.0):
-        for sy in (1.0, -1.0):
-            y = sy * b * np.sqrt(1.0 - (x / a) ** 2) - sy * np.linspace(0.0, depth, 300)
-            y = y[(x / a) ** 2 + (y / b) ** 2 < 0.999]
-            xs = np.full(len(y), sx * x)
-            lines.append(np.column_stack([xs, y, double_dome_height(xs, y)]))
-    return lines
-
-
 def test_side_darts_open_on_a_locking_fabric():
     """The darts of docs/composites.md ("The shipped double dome") on the coarser mesh of the
     part (``cell_size = 8``, 1,094 cells; a few seconds): a fabric that locks at 50° (stiffness
     100 G there) keeps its shear below 50° and each of the four darts from the long sides
     opens (measured: 48.93° before, 47.13° after; mouths 8.0, 62.7, 15.4, 14.4 mm)."""
     from vares.analysis.darts import solve_with_darts
+    from vares.geometry.double_dome import side_darts
     from vares.materials.shear_locking import locking_fabric
 
     mesh = double_dome(cell_size=8.0)
@@ -230,7 +217,7 @@ def test_side_darts_open_on_a_locking_fabric():
         mesh,
         law,
         locking_angle=LOCKING,
-        polylines=side_darts(55.0, 75.0),
+        polylines=side_darts([55.0], 75.0),
         warp_direction=(1.0, 0.0, 0.0),
     )
     assert darted.before.converged and darted.after.converged

@@ -29,7 +29,7 @@ import numpy as np
 
 from .mesh import SurfaceMesh
 
-__all__ = ["double_dome", "double_dome_height"]
+__all__ = ["double_dome", "double_dome_height", "side_darts"]
 
 
 def double_dome_height(
@@ -131,3 +131,24 @@ def _thinned(outline, a, b, cell_size, rng, radius, height, spacing, blend) -> n
             grid.setdefault((i, j, k), []).append((x, y, z))
             kept.append((x, y))
     return np.array(kept)
+
+
+def side_darts(
+    xs, depth: float, radius: float = 70.0, spacing: float = 110.0, flange: float = 30.0
+) -> list[np.ndarray]:
+    """Dart lines on the default double dome's surface from its long sides: at every ``x`` of
+    ``xs`` and its mirror image ``−x``, from the outline (of ``double_dome(radius, spacing=…,
+    flange=…)``) along ∓y, across the warp along x, ``depth`` mm into the plan; 300 points
+    each, those strictly inside the outline. Four lines for one ``x`` (mm)."""
+    a, b = spacing / 2 + radius + flange, radius + flange
+    lines = []
+    for x in sorted({float(v) for v in xs} | {-float(v) for v in xs}):
+        if not abs(x) < a:
+            raise ValueError(f"a side dart's x must lie within ±{a:g}; got {x:g}")
+        for sign in (1.0, -1.0):
+            y = sign * b * np.sqrt(1.0 - (x / a) ** 2) - sign * np.linspace(0.0, depth, 300)
+            y = y[(x / a) ** 2 + (y / b) ** 2 < 0.999]
+            xs_ = np.full(len(y), x)
+            height = double_dome_height(xs_, y, radius=radius, spacing=spacing)
+            lines.append(np.column_stack([xs_, y, height]))
+    return lines
