@@ -125,6 +125,11 @@ class CutResult:
                 "the strips are planned to lie in pairs on the roll, head to tail, the warp along "
                 "one seam of each" + _estimates(plan.compared)
             )
+        if plan.pairs_refused:
+            notes.append(
+                "the strips lie one after the other: planned in pairs, head to tail, they could "
+                f"not be ({plan.pairs_refused})"
+            )
         if plan.split is not None:
             a, b = (plan.panels[k].name for k in plan.split)
             notes.append(

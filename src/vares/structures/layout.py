@@ -3,10 +3,9 @@
 For a family of cutting lines (:mod:`vares.geometry.line_families`) the strips are found by
 iterating on what matters, the flattened width: place the lines, cut the mesh along them, flatten
 every strip (least-squares conformal map, scaled to its area) and measure its extent across the
-warp, allowances included; then move the lines so that all strips get the same width (each
-gap's parameter span is scaled by (mean width / its width)^0.7, a few times, keeping the best),
-and take the least number of strips whose equalised width fits the roll: one strip fewer is
-tried too, and does not fit.
+warp, allowances included; then move the lines so that all strips get the same width, and take
+the least number of strips whose equalised width fits the roll: one strip fewer is tried too,
+and does not fit (how the number is searched for: :mod:`.equalise`).
 
 A line is every piece of the plane section of its parameter (a plane near a sagging edge cuts the
 surface twice: the corner beyond it is a strip of its own), or the geodesic between the ends of
@@ -43,6 +42,7 @@ from ..geometry.line_families import LineFamily, geodesic_between_ends, line_fam
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.refine import refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
+from .equalise import least_count
 from .panels import Panel, split_panels
 from .strip_plan import StripPlan
 from .widths import pattern_direction, strip_widths
@@ -60,8 +60,6 @@ __all__ = [
 ]
 
 SEAM_KINDS = ("geodesic", "planar")
-#: Equalising iterations per number of strips, and the width ratio that is equal enough.
-_EQUALISE, _EQUAL = 6, 1.005
 #: Cells across a strip of roll width at least (by their longest edges; module docs).
 CELLS_ACROSS = 2
 #: The most triangles the surface may be refined to for the strips: a narrower roll is refused
@@ -133,40 +131,8 @@ def plan_strips(
     smallest = 2 if family.closed else 1
     first, _ = evaluate(np.full(8, total / 8) if family.closed else np.array([total]))
     count = max(smallest, math.ceil(sum(first.widths) / width))
-    tried: dict[int, StripPlan] = {}
-    evaluations, history = 1, []
-    while count not in tried:
-        if count > max_strips:
-            raise CuttingError(f"more than {max_strips} strips would be needed")
-        spans, plan = np.full(count, total / count), None
-        for _ in range(_EQUALISE):
-            candidate, widths = evaluate(spans)
-            evaluations += 1
-            if plan is None or widths.max() < max(plan.widths):
-                plan = candidate
-            if widths.max() <= _EQUAL * widths.min():
-                break
-            # damped (widths jump with the mesh); an empty gap counts as a narrow one
-            widths = np.maximum(widths, 0.1 * widths.max())
-            spans = spans * (widths.mean() / widths) ** 0.7
-            spans *= total / spans.sum()
-        tried[count] = plan
-        history.append((count, max(plan.widths)))
-        fits = max(plan.widths) <= width
-        if fits and count - 1 >= smallest and count - 1 not in tried:
-            count -= 1
-        elif fits:
-            break
-        else:  # as many more as the widest strip is too wide (then back down, one at a time)
-            count = max(count + 1, math.ceil(count * max(plan.widths) / width))
-    best = min((c for c, p in tried.items() if max(p.widths) <= width), default=None)
-    if best is None:
-        fit = "two side by side, each about half of it" if interlock else "one"
-        raise CuttingError(
-            f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
-        )
-    plan = tried[best]
-    plan.evaluations, plan.history = evaluations, history
+    plan = least_count(evaluate, total, count, smallest, width, max_strips, interlock)
+    plan.evaluations += 1
     return plan
 
 

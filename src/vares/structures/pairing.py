@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..geometry.cross_cut import cut_across
-from ..geometry.surface_lines import SurfaceLine, geodesic_lines
+from ..geometry.surface_lines import CuttingError, SurfaceLine, geodesic_lines
 from .panels import split_panels
 from .strip_plan import StripPlan
 from .widths import pair_width, roll_estimate
@@ -32,7 +32,8 @@ def choose_plan(planned: Callable[[bool], StripPlan], mode: str, paired: bool | 
     ``never``) or ``paired`` (an earlier plan's choice), else in pairs where, by the flattened
     strips, that saves at least ``SAVING`` of the roll's length (tried only where the strips
     are tapered enough: two need less than 2 (1 − ``SAVING``) times the width of one, one seam
-    along the warp). ``compared`` of the plan gives both estimates (strips, roll length)."""
+    along the warp; where they cannot be planned in pairs, ``pairs_refused`` of the plan alone
+    says why). ``compared`` of the plan gives both estimates (strips, roll length)."""
     if paired is None and mode != "auto":
         paired = mode == "always"
     if paired is not None:
@@ -41,7 +42,11 @@ def choose_plan(planned: Callable[[bool], StripPlan], mode: str, paired: bool | 
     alone.compared = {"alone": (len(alone.panels), roll_estimate(alone.lengths, 1))}
     if max(alone.straight_pairs) >= 2 * (1 - SAVING) * max(alone.widths):
         return alone
-    pairs = planned(True)
+    try:
+        pairs = planned(True)
+    except CuttingError as refused:  # in pairs is a saving, not a must: the strips alone
+        alone.pairs_refused = str(refused)
+        return alone
     estimate = (len(pairs.panels), roll_estimate(pairs.lengths, 2))
     alone.compared = pairs.compared = {**alone.compared, "pairs": estimate}
     if estimate[1] <= (1 - SAVING) * alone.compared["alone"][1]:

@@ -31,7 +31,8 @@ class StripPlan:
     With ``interlock`` the strips are planned in pairs (``widths`` are pairs' widths);
     ``lengths`` are the strips' extents along the warp, ``straight_pairs`` the widths their
     pairs would need with one seam along the warp, ``compared`` the roll estimates of both
-    plans (:mod:`.pairing`) and ``split`` the two halves of a strip cut across, if any.
+    plans (:mod:`.pairing`), ``pairs_refused`` why strips planned alone could not be planned in
+    pairs (where that was tried) and ``split`` the two halves of a strip cut across, if any.
     """
 
     cut: CutMesh
@@ -51,4 +52,5 @@ class StripPlan:
     straight_pairs: list[float] = field(default_factory=list)
     compared: dict[str, tuple[int, float]] = field(default_factory=dict)
     split: tuple[int, int] | None = None
+    pairs_refused: str = ""
     straight_warp: bool = False

@@ -1,0 +1,153 @@
+"""How many strips, and where their lines go: the least number of gaps between cutting lines
+whose widths, equalised, fit the roll (:func:`vares.structures.layout.plan_strips`).
+
+A number of gaps is evaluated (lines placed, the surface cut, the strips flattened and measured)
+and its lines moved until the gaps are equally wide: each span is scaled by (mean width / its
+width)^0.7 (damped: widths jump with the mesh), ``_EQUALISE`` evaluations at most. While the
+number is searched for, one stops as soon as its widest strip fits the roll (then one fewer is
+tried) or its mean gap width shows that none will (``_HOPELESS``: the gaps' widths add up to
+about the same whatever their spans; then as many more as the mean is too wide); the next
+number starts from the last one's lines, respaced into parts of equal estimated width. The
+number taken, the least that fits, is then equalised in full (to ``_EQUAL``, or the budget).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from ..geometry.surface_lines import CuttingError
+from .strip_plan import StripPlan
+
+__all__ = ["least_count"]
+
+#: Equalising evaluations per number of gaps, and the width ratio that is equal enough.
+_EQUALISE, _EQUAL = 6, 1.005
+#: A number of gaps whose mean gap width exceeds the roll width by this factor is not equalised
+#: further (module docs).
+_HOPELESS = 1.02
+#: Twice the gaps (or more) and still this fraction of their mean width: more will not fit.
+_NARROWER = 0.8
+
+#: A layout of gaps of the given parameter spans, and the width of each gap.
+Evaluate = Callable[[np.ndarray], tuple[StripPlan, np.ndarray]]
+
+
+class _Count:
+    """The layouts tried for one number of gaps: the best (the narrowest widest strip), its
+    spans and gap widths, the evaluations spent and whether they were equalised to ``_EQUAL``."""
+
+    def __init__(self) -> None:
+        self.plan: StripPlan | None = None
+        self.spans = self.widths = self.following = np.zeros(0)
+        self.evaluations, self.equal = 0, False
+
+    @property
+    def widest(self) -> float:
+        return max(self.plan.widths)
+
+    def equalise(
+        self, evaluate: Evaluate, spans: np.ndarray, total: float, width: float, polish: bool
+    ) -> None:
+        """Move the lines from ``spans`` until the gaps are equally wide, or (unless ``polish``)
+        until the widest strip fits ``width`` or the gaps' mean width shows that none will
+        (``_HOPELESS``); at most ``_EQUALISE`` evaluations for this number of gaps in all."""
+        self.following = spans
+        while self.evaluations < _EQUALISE and not self.equal:
+            spans = self.following
+            candidate, widths = evaluate(spans)
+            self.evaluations += 1
+            if self.plan is None or widths.max() < self.widest:
+                self.plan, self.spans, self.widths = candidate, spans, widths
+            if widths.max() <= _EQUAL * widths.min():
+                self.equal = True
+                break
+            self.following = _respaced(spans, widths, len(spans), total, damping=0.7)
+            if not polish and (self.widest <= width or widths.mean() > _HOPELESS * width):
+                break
+
+
+def _respaced(
+    spans: np.ndarray, widths: np.ndarray, count: int, total: float, damping: float = 1.0
+) -> np.ndarray:
+    """New spans from the ``widths`` measured for ``spans``. For as many gaps, each span is
+    scaled by (mean width / its width) ^ ``damping`` (widths jump with the mesh). For another
+    ``count``, the spans of equal width if the width grew evenly within each measured gap: the
+    cumulative width inverted at ``count`` equal parts. An empty gap counts as a narrow one."""
+    widths = np.maximum(widths, 0.1 * widths.max())
+    if count == len(spans):
+        scaled = spans * (widths.mean() / widths) ** damping
+        return scaled * (total / scaled.sum())
+    cumulative = np.concatenate([[0.0], np.cumsum(widths)])
+    bounds = np.interp(
+        np.linspace(0.0, cumulative[-1], count + 1), cumulative, np.r_[0.0, np.cumsum(spans)]
+    )
+    return np.diff(bounds) * (total / bounds[-1])
+
+
+def _narrowing(tried: dict[int, _Count], count: int, width: float, interlock: bool) -> None:
+    """Raise if the gaps do not get narrower with their number: ``count`` gaps, too wide for
+    ``width``, at least ``_NARROWER`` × as wide on average as half as many or fewer were (gaps
+    as wide as their spans would be half as wide). Strips whose width does not come from their
+    span (strips in pairs whose flattened seams bow more than the roll is wide) fit no roll by
+    more of them."""
+    mean = tried[count].widths.mean()
+    for fewer, trial in tried.items():
+        if 2 * fewer <= count and trial.widest > width and mean > _NARROWER * trial.widths.mean():
+            kind = "strips in pairs" if interlock else "strips"
+            raise CuttingError(
+                f"{kind} do not get narrower with their number: {fewer} gaps between cutting "
+                f"lines are {trial.widths.mean():.4g} wide on average, {count} gaps "
+                f"{mean:.4g} (strips at most {width:g} wide)"
+                + (
+                    ": plan them one after the other (interlock never)"
+                    if interlock
+                    else ": their flattened strips bow; try another strip direction or layout"
+                )
+            )
+
+
+def least_count(
+    evaluate: Evaluate,
+    total: float,
+    count: int,
+    smallest: int,
+    width: float,
+    max_strips: int,
+    interlock: bool,
+) -> StripPlan:
+    """The plan of the least number of gaps (at least ``smallest``) whose equalised widths fit
+    ``width``, from a first estimate ``count`` (module docs); ``total`` is the family's
+    parameter span, ``interlock`` only words the error when no number up to ``max_strips``
+    fits."""
+    tried: dict[int, _Count] = {}
+    spans = np.full(count, total / count)
+    while count not in tried:
+        if count > max_strips:
+            raise CuttingError(f"more than {max_strips} strips would be needed")
+        tried[count] = trial = _Count()
+        trial.equalise(evaluate, spans, total, width, polish=False)
+        fits = trial.widest <= width
+        if fits and count - 1 >= smallest and count - 1 not in tried:
+            following = count - 1
+        elif fits:
+            break
+        else:  # as many more as the mean gap is too wide (then back down, one at a time)
+            _narrowing(tried, count, width, interlock)
+            following = max(count + 1, math.ceil(count * trial.widths.mean() / width))
+        spans = _respaced(trial.spans, trial.widths, following, total)
+        count = following
+    best = min((c for c, t in tried.items() if t.widest <= width), default=None)
+    if best is None:
+        fit = "two side by side, each about half of it" if interlock else "one"
+        raise CuttingError(
+            f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
+        )
+    taken = tried[best]
+    taken.equalise(evaluate, taken.following, total, width, polish=True)
+    plan = taken.plan
+    plan.evaluations = sum(t.evaluations for t in tried.values())
+    plan.history = [(c, t.widest) for c, t in tried.items()]
+    return plan

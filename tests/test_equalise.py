@@ -1,0 +1,97 @@
+"""The search for the number of strips (vares.structures.equalise) on a model whose gap widths
+are known exactly: a gap is as wide as the integral of a width density over its span."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from vares.geometry.surface_lines import CuttingError
+from vares.structures.equalise import _EQUAL, _respaced, least_count
+
+
+def density_model(calls: list[int]):
+    """Gap widths of spans over [0, 1] for the width density 1 + 3 s² (2 in all)."""
+
+    def evaluate(spans):
+        bounds = np.concatenate([[0.0], np.cumsum(spans)])
+        widths = np.diff(bounds + bounds**3)
+        calls.append(len(spans))
+        return SimpleNamespace(widths=list(widths)), widths
+
+    return evaluate
+
+
+def test_respacing_into_another_number_of_gaps_equalises_a_linear_model():
+    """Widths in proportion to spans within each gap: respaced into another number of gaps,
+    the gaps are equally wide (the inverse of the cumulative width, piecewise linear)."""
+    spans = np.array([0.1, 0.5, 0.4])
+    widths = np.array([0.3, 0.5, 1.2])  # densities 3, 1, 3
+    for count in (2, 4, 5, 8):
+        new = _respaced(spans, widths, count, 1.0)
+        assert new.sum() == pytest.approx(1.0, abs=1e-14) and np.all(new > 0)
+        edges = np.concatenate([[0.0], np.cumsum(new)])
+        cumulative = np.interp(edges, np.r_[0.0, np.cumsum(spans)], np.r_[0.0, np.cumsum(widths)])
+        assert np.diff(cumulative) == pytest.approx(np.full(count, 2.0 / count), rel=1e-12)
+
+
+@pytest.mark.parametrize("start", [3, 12])
+def test_the_least_number_that_fits_is_found_and_equalised(start):
+    """2 in all at a width of 0.3: 7 gaps fit (2/7), 6 cannot (2/6 = 0.333). From above and
+    from below, the search ends on 7 equal gaps, spending few evaluations on the others: 6 is
+    left after one (its mean is too wide), a fitting number as soon as it fits."""
+    calls: list[int] = []
+    plan = least_count(density_model(calls), 1.0, start, 1, 0.3, 200, False)
+    assert len(plan.widths) == 7
+    assert max(plan.widths) <= _EQUAL * min(plan.widths)
+    assert calls.count(6) == 1
+    assert plan.evaluations == len(calls) and plan.evaluations <= 12
+    assert dict(plan.history)[7] == pytest.approx(max(plan.widths))
+
+
+def test_no_number_up_to_the_limit_fits():
+    with pytest.raises(CuttingError, match="more than 20 strips"):
+        least_count(density_model([]), 1.0, 3, 1, 0.05, 20, False)
+
+
+def test_gaps_that_do_not_get_narrower_are_refused_early():
+    """Every gap at least 1.0 wide whatever its span (a bow that does not scale): a roll of 0.9
+    fits no number of them, and the search says so once twice the gaps are not narrower,
+    instead of trying numbers up to the limit."""
+    calls: list[int] = []
+    inner = density_model(calls)
+
+    def bowed(spans):
+        plan, widths = inner(spans)
+        widths = 1.0 + 0.1 * widths
+        plan.widths = list(widths)
+        return plan, widths
+
+    with pytest.raises(CuttingError, match="do not get narrower with their number"):
+        least_count(bowed, 1.0, 3, 1, 0.9, 200, True)
+    assert max(calls) <= 12 and len(calls) <= 8
+
+
+def test_strips_that_cannot_be_paired_are_planned_alone():
+    """With interlock auto, a plan in pairs that is refused leaves the strips alone, and the
+    plan says why (a note of the cut)."""
+    from vares.structures.pairing import choose_plan
+
+    alone = SimpleNamespace(
+        widths=[2.0, 2.0],
+        straight_pairs=[2.0, 2.0],
+        lengths=[10.0, 10.0],
+        panels=[0, 1],
+        compared={},
+        pairs_refused="",
+    )
+
+    def planned(interlock):
+        if interlock:
+            raise CuttingError("strips in pairs do not get narrower with their number")
+        return alone
+
+    assert choose_plan(planned, "auto", None) is alone
+    assert "do not get narrower" in alone.pairs_refused
+    with pytest.raises(CuttingError):
+        choose_plan(planned, "always", None)
