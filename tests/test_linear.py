@@ -42,6 +42,17 @@ def test_upper_triangle_map_adds_missing_diagonal_entries():
     )
 
 
+def test_upper_triangle_map_of_a_matrix_with_its_whole_diagonal():
+    """Every diagonal entry stored: the map keeps the upper entries in their CSR order."""
+    matrix = _saddle_point_matrix() + sp.identity(_saddle_point_matrix().shape[0]) * 1e-3
+    matrix = sp.csr_matrix(matrix)
+    matrix.sort_indices()
+    index, indptr, indices = linear._upper_triangle_map(matrix)
+    assert np.all(index >= 0) and np.all(np.diff(index) > 0)
+    upper = sp.csr_matrix((matrix.data[index], indices, indptr), shape=matrix.shape)
+    np.testing.assert_array_equal(upper.toarray(), np.triu(matrix.toarray()))
+
+
 @pytest.mark.parametrize("name", linear.available_solvers())
 def test_every_solver_solves_a_bordered_indefinite_system(name):
     matrix = _saddle_point_matrix(seed=1)

@@ -309,11 +309,14 @@ def _upper_triangle_map(matrix: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, 
     has_diagonal = np.zeros(n, dtype=bool)
     has_diagonal[rows[keep][matrix.indices[keep] == rows[keep]]] = True
     missing = np.flatnonzero(~has_diagonal)
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    if not missing.size:  # the kept entries are in row order, their columns sorted already
+        np.cumsum(np.bincount(rows[keep], minlength=n), out=indptr[1:])
+        return keep, indptr, matrix.indices[keep]
     all_rows = np.concatenate([rows[keep], missing])
     all_cols = np.concatenate([matrix.indices[keep], missing])
     source = np.concatenate([keep, np.full(missing.size, -1)])
     order = np.lexsort((all_cols, all_rows))
-    indptr = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(all_rows, minlength=n), out=indptr[1:])
     return source[order], indptr, all_cols[order]
 
