@@ -203,10 +203,13 @@ def test_the_example_command_refuses_quads_in_one_line(tmp_path):
 
 
 def test_side_darts_open_on_a_locking_fabric():
-    """The darts of docs/composites.md ("The shipped double dome") on the coarser mesh of the
-    part (``cell_size = 8``, 1,094 cells; a few seconds): a fabric that locks at 50° (stiffness
-    100 G there) keeps its shear below 50° and each of the four darts from the long sides
-    opens (measured: 48.93° before, 47.13° after; mouths 8.0, 62.7, 15.4, 14.4 mm)."""
+    """The darts of docs/composites.md ("Side darts on a fabric that locks") on the coarser mesh
+    of the part (``cell_size = 8``, 1,094 cells; a few seconds), on a fabric that locks at 50°
+    (stiffness 100 G there): the four darts from the long sides open and lower the largest
+    shear by more than 1° (measured: 48.93° before, 47.13° after, 30 and 56 iterations; mouths
+    8.0, 62.7, 15.4, 14.4 mm). On this mesh the shear is below 50° before the darts too, so
+    "below 50°" alone would not show that they relieve it; the same dart lines made edges of
+    the mesh but not opened give 49.07° (1,224 cells, 32 iterations), which fails the margin."""
     from vares.analysis.darts import solve_with_darts
     from vares.geometry.double_dome import side_darts
     from vares.materials.shear_locking import locking_fabric
@@ -223,6 +226,7 @@ def test_side_darts_open_on_a_locking_fabric():
     assert darted.before.converged and darted.after.converged
     assert len(darted.dart_lines) == 4
     assert darted.max_shear_before < LOCKING and darted.max_shear_after < LOCKING
+    assert darted.max_shear_after < darted.max_shear_before - 1.0  # the darts relieve it
     for gaps in darted.slits.lip_gaps(darted.after.material_coordinates):
         assert gaps[0] > 5.0  # every mouth opens (mm)
         assert gaps[-1] == 0.0  # the tip is one node
