@@ -321,9 +321,7 @@ class SurfaceMesh:
 
     def _check_manifold_vertices(self, table: EdgeTable) -> None:
         """Around each node the cells must form a single fan (no 'bow-tie' nodes)."""
-        corner_node, fan = corner_fans(
-            self.num_points, table.directed, table.owner, table.edge_id, table.order
-        )
+        corner_node, fan = corner_fans(table)
         fan_node = np.empty(fan.max() + 1, dtype=np.int64)
         fan_node[fan] = corner_node  # the corners of a fan are at one node
         fans_per_node = np.bincount(fan_node, minlength=self.num_points)
@@ -336,34 +334,24 @@ class SurfaceMesh:
             )
 
 
-def corner_fans(
-    num_points: int,
-    directed: np.ndarray,
-    owner: np.ndarray,
-    edge_id: np.ndarray,
-    order: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
+def corner_fans(table: EdgeTable) -> tuple[np.ndarray, np.ndarray]:
     """The fan of every cell corner: corners (one per directed edge, at its start node) of the
     same node are in one fan when their cells are joined around the node by shared edges.
-    ``order`` sorts the edges by ``edge_id`` (stable), if known. Returns the node and the fan
-    label of every corner."""
+    Returns the node and the fan label of every corner (in the table's order of edges)."""
+    directed, following = table.directed, table.following
     corner_node = directed[:, 0]
-    corner_key = owner * num_points + corner_node
-    by_key = np.argsort(corner_key)
-    sorted_key = corner_key[by_key]
 
-    def corner_of(cell: np.ndarray, node: np.ndarray) -> np.ndarray:
-        return by_key[np.searchsorted(sorted_key, cell * num_points + node)]
+    def corner_of(edge: np.ndarray, node: np.ndarray) -> np.ndarray:
+        """The corner of an edge's cell at one of the edge's ends: the edge's own if it
+        starts there, else the next edge's of the cell."""
+        return np.where(directed[edge, 0] == node, edge, following[edge])
 
-    srt = np.argsort(edge_id, kind="stable") if order is None else order
-    ids = edge_id[srt]
-    pair = np.flatnonzero(ids[1:] == ids[:-1])
-    a, b = srt[pair], srt[pair + 1]
+    a, b = table.pairs()
     rows, cols = [], []
     for k in (0, 1):
         node = directed[a, k]
-        rows.append(corner_of(owner[a], node))
-        cols.append(corner_of(owner[b], node))
+        rows.append(corner_of(a, node))
+        cols.append(corner_of(b, node))
     graph = sp.coo_matrix(
         (np.ones(2 * a.size), (np.concatenate(rows), np.concatenate(cols))),
         shape=(corner_node.size, corner_node.size),
@@ -375,21 +363,25 @@ def corner_fans(
 @dataclass(frozen=True)
 class EdgeTable:
     """Every directed cell edge, the cell it belongs to, the id of its undirected edge, the
-    number of cells at each undirected edge, and the stable order that sorts by edge id."""
+    number of cells at each undirected edge, the stable order that sorts by edge id, and the
+    next edge of the same cell (round the cell, as its nodes are listed)."""
 
     directed: np.ndarray
     owner: np.ndarray
     edge_id: np.ndarray
     counts: np.ndarray
     order: np.ndarray
+    following: np.ndarray
 
     @classmethod
     def of_cells(cls, cells: Mapping[str, np.ndarray], num_points: int) -> EdgeTable:
         """The table of cell blocks by type (global cell order: block after block)."""
-        return cls.of(directed_edges(cells), num_points)
+        return cls.of(directed_edges(cells), num_points, following_edges(cells))
 
     @classmethod
-    def of(cls, edges: tuple[np.ndarray, np.ndarray], num_points: int) -> EdgeTable:
+    def of(
+        cls, edges: tuple[np.ndarray, np.ndarray], num_points: int, following: np.ndarray
+    ) -> EdgeTable:
         directed, owner = edges
         key = np.minimum(directed[:, 0], directed[:, 1]) * num_points + np.maximum(
             directed[:, 0], directed[:, 1]
@@ -400,7 +392,7 @@ class EdgeTable:
         start[1:] = ordered[1:] != ordered[:-1]
         edge_id = np.empty(key.size, dtype=np.int64)
         edge_id[order] = np.cumsum(start) - 1
-        return cls(directed, owner, edge_id, np.bincount(edge_id), order)
+        return cls(directed, owner, edge_id, np.bincount(edge_id), order, following)
 
     def pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The two directed edges of every edge shared by (at least) two cells."""
@@ -422,6 +414,18 @@ def directed_edges(cells: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndar
     if not edges:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
     return np.vstack(edges), np.concatenate(owner)
+
+
+def following_edges(cells: Mapping[str, np.ndarray]) -> np.ndarray:
+    """For every directed edge of :func:`directed_edges` the index of the next edge of its cell
+    (edge ``i + 1`` of the same cell, edge 0 after the last)."""
+    out, offset = [], 0
+    for block in cells.values():
+        m, nen = block.shape
+        local = np.arange(m * nen)
+        out.append(offset + (local + m) % (m * nen))
+        offset += m * nen
+    return np.concatenate(out) if out else np.zeros(0, dtype=np.int64)
 
 
 def connected_pieces(points: np.ndarray, cells: Mapping[str, np.ndarray]) -> np.ndarray:

@@ -266,7 +266,7 @@ def _split_bow_ties(points: np.ndarray, blocks: dict[str, np.ndarray]):
     block_of = np.concatenate([np.full(b.size, k) for k, b in enumerate(blocks.values())])
     col_of = np.concatenate([np.repeat(np.arange(b.shape[1]), len(b)) for b in blocks.values()])
     row_of = table.owner - offsets[block_of]
-    node, fan = corner_fans(len(points), table.directed, table.owner, table.edge_id, table.order)
+    node, fan = corner_fans(table)
     fans = int(fan.max()) + 1 if fan.size else 1
     keys, label = np.unique(node.astype(np.int64) * fans + fan, return_inverse=True)
     pairs = np.column_stack([keys // fans, keys % fans])  # (node, fan), sorted by node
