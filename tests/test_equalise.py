@@ -95,3 +95,50 @@ def test_strips_that_cannot_be_paired_are_planned_alone():
     assert "do not get narrower" in alone.pairs_refused
     with pytest.raises(CuttingError):
         choose_plan(planned, "always", None)
+
+
+@pytest.mark.parametrize(("even", "strips"), [(0.99, 5), (1.003, 6)])
+def test_a_number_that_misses_by_the_noise_is_tried_again_from_even_spans(even, strips):
+    """Five gaps miss a roll of 1.0 by 0.4 % from the lines of six respaced (widths jump with the
+    mesh): they are tried once more from evenly spaced lines, and taken where those fit."""
+    calls: list[tuple[int, bool]] = []
+
+    def scripted(spans):
+        is_even = bool(np.allclose(spans, spans.mean(), rtol=1e-9))
+        calls.append((len(spans), is_even))
+        if len(spans) == 6:
+            widths = np.array([0.85, 0.9, 0.95, 0.9, 0.85, 0.9])
+        elif len(spans) == 5:  # the widest 0.4 % too wide, the mean within the roll
+            widths = np.full(5, even) if is_even else np.array([1.004, 0.99, 0.99, 0.99, 0.99])
+        else:
+            widths = np.full(len(spans), 1.3)
+        return SimpleNamespace(widths=list(widths)), widths
+
+    plan = least_count(scripted, 1.0, 6, 1, 1.0, 200, False)
+    assert len(plan.widths) == strips
+    assert (5, False) in calls and (5, True) in calls  # the respaced start, then the even one
+    assert plan.evaluations == len(calls)
+
+
+def test_a_miss_whose_mean_is_too_wide_is_not_tried_again():
+    """Every layout of five gaps 0.4 % too wide on average: no other start can fit them."""
+    calls: list[int] = []
+
+    def scripted(spans):
+        calls.append(len(spans))
+        widths = np.full(len(spans), 1.004 if len(spans) == 5 else 0.8)
+        return SimpleNamespace(widths=list(widths)), widths
+
+    plan = least_count(scripted, 1.0, 6, 1, 1.0, 200, False)
+    assert len(plan.widths) == 6 and calls.count(5) == 1
+
+
+def test_gaps_equal_but_for_the_noise_start_the_next_number_evenly():
+    """Widths within 3 % of each other are noise (a surface of revolution's strips): the next
+    number starts from even spans, where lines fall on the mesh's own meridians; beyond that
+    the cumulative width is inverted."""
+    spans = np.array([0.3, 0.3, 0.4])
+    even = _respaced(spans, np.array([1.0, 1.02, 0.995]), 4, 1.0)
+    assert even == pytest.approx(np.full(4, 0.25), abs=1e-15)
+    uneven = _respaced(spans, np.array([1.0, 1.2, 0.9]), 4, 1.0)
+    assert not np.allclose(uneven, 0.25, atol=1e-3)

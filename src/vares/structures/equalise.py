@@ -7,8 +7,12 @@ width)^0.7 (damped: widths jump with the mesh), ``_EQUALISE`` evaluations at mos
 number is searched for, one stops as soon as its widest strip fits the roll (then one fewer is
 tried) or its mean gap width shows that none will (``_HOPELESS``: the gaps' widths add up to
 about the same whatever their spans; then as many more as the mean is too wide); the next
-number starts from the last one's lines, respaced into parts of equal estimated width. The
-number taken, the least that fits, is then equalised in full (to ``_EQUAL``, or the budget).
+number starts from the last one's lines, respaced into parts of equal estimated width (from
+evenly spaced lines where the last one's gaps were as wide as each other but for the mesh's
+noise, ``_EVEN``). The
+number taken, the least that fits, is then equalised in full (to ``_EQUAL``, or the budget);
+if one fewer missed the roll by less than the widths' noise (``_NOISE``) with its mean gap
+within the roll, it is tried again from evenly spaced lines first, and taken if it fits.
 """
 
 from __future__ import annotations
@@ -28,6 +32,13 @@ _EQUALISE, _EQUAL = 6, 1.005
 #: A number of gaps whose mean gap width exceeds the roll width by this factor is not equalised
 #: further (module docs).
 _HOPELESS = 1.02
+#: Gaps whose widths differ by less than this factor are equally wide but for the mesh's noise
+#: (the widths jump by 1-4 % from one layout to the next, measured on the coarse designs and
+#: the tent): the next number of gaps starts from evenly spaced lines, not from theirs respaced.
+_EVEN = 1.03
+#: A number of gaps whose widest strip misses the roll by less than this factor (about how much
+#: the widths jump with the mesh from one layout to the next) is tried again from even spans.
+_NOISE = 1.01
 #: Twice the gaps (or more) and still this fraction of their mean width: more will not fit.
 _NARROWER = 0.8
 
@@ -75,8 +86,11 @@ def _respaced(
     """New spans from the ``widths`` measured for ``spans``. For as many gaps, each span is
     scaled by (mean width / its width) ^ ``damping`` (widths jump with the mesh). For another
     ``count``, the spans of equal width if the width grew evenly within each measured gap: the
-    cumulative width inverted at ``count`` equal parts. An empty gap counts as a narrow one."""
+    cumulative width inverted at ``count`` equal parts; even spans where the gaps were equally
+    wide to the widths' noise (``_EVEN``). An empty gap counts as a narrow one."""
     widths = np.maximum(widths, 0.1 * widths.max())
+    if count != len(spans) and widths.max() <= _EVEN * widths.min():
+        return np.full(count, total / count)  # equal to the noise: as wide per span everywhere
     if count == len(spans):
         scaled = spans * (widths.mean() / widths) ** damping
         return scaled * (total / scaled.sum())
@@ -145,9 +159,22 @@ def least_count(
         raise CuttingError(
             f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
         )
+    spent = sum(t.evaluations for t in tried.values())
+    fewer = tried.get(best - 1)
+    if (  # a miss by the widths' noise, where the mean width would fit
+        fewer is not None and fewer.widest <= _NOISE * width and fewer.widths.mean() <= width
+    ):
+        again = _Count()  # another start: lines evenly spaced
+        again.equalise(evaluate, np.full(best - 1, total / (best - 1)), total, width, False)
+        spent += again.evaluations
+        if again.widest < fewer.widest:
+            tried[best - 1] = again
+        if again.widest <= width:
+            best = best - 1
     taken = tried[best]
+    before = taken.evaluations
     taken.equalise(evaluate, taken.following, total, width, polish=True)
     plan = taken.plan
-    plan.evaluations = sum(t.evaluations for t in tried.values())
+    plan.evaluations = spent + taken.evaluations - before
     plan.history = [(c, t.widest) for c, t in tried.items()]
     return plan
