@@ -88,9 +88,11 @@ def run(
     return {
         "cells": mesh.num_cells,
         "converged": result.converged,
-        "iterations": " + ".join(str(s.iterations) for s in result.stages),
+        "iterations": " + ".join(str(s.iterations) for s in result.stages)
+        or str(result.iterations),
         "aligning": " + ".join(str(n) for n in alignment_iterations(result.history)),
-        "stage_seconds": " + ".join(f"{s.elapsed:.1f}" for s in result.stages),
+        "stage_seconds": " + ".join(f"{s.elapsed:.1f}" for s in result.stages)
+        or f"{result.elapsed:.1f}",
         "seconds": result.elapsed,
         "table": table,
         "spread": np.nanmax(table, axis=0) - np.nanmin(table, axis=0),
