@@ -142,3 +142,20 @@ def test_gaps_equal_but_for_the_noise_start_the_next_number_evenly():
     assert even == pytest.approx(np.full(4, 0.25), abs=1e-15)
     uneven = _respaced(spans, np.array([1.0, 1.2, 0.9]), 4, 1.0)
     assert not np.allclose(uneven, 0.25, atol=1e-3)
+
+
+def test_a_miss_from_even_spans_is_not_started_evenly_again():
+    """Five gaps started from even spans (six were equally wide) miss by 0.4 %: the second
+    start would repeat the first, so it is not made."""
+    calls: list[int] = []
+
+    def scripted(spans):
+        calls.append(len(spans))
+        if len(spans) == 5:
+            widths = np.array([1.004, 0.99, 0.99, 0.99, 0.99])
+        else:
+            widths = np.full(len(spans), 0.85)
+        return SimpleNamespace(widths=list(widths)), widths
+
+    plan = least_count(scripted, 1.0, 6, 1, 1.0, 200, False)
+    assert len(plan.widths) == 6 and calls.count(5) == 6  # its own six evaluations, no more

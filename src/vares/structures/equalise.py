@@ -48,11 +48,12 @@ Evaluate = Callable[[np.ndarray], tuple[StripPlan, np.ndarray]]
 
 class _Count:
     """The layouts tried for one number of gaps: the best (the narrowest widest strip), its
-    spans and gap widths, the evaluations spent and whether they were equalised to ``_EQUAL``."""
+    spans and gap widths, the spans it started from, the evaluations spent and whether they
+    were equalised to ``_EQUAL``."""
 
     def __init__(self) -> None:
         self.plan: StripPlan | None = None
-        self.spans = self.widths = self.following = np.zeros(0)
+        self.spans = self.widths = self.following = self.start = np.zeros(0)
         self.evaluations, self.equal = 0, False
 
     @property
@@ -66,6 +67,8 @@ class _Count:
         until the widest strip fits ``width`` or the gaps' mean width shows that none will
         (``_HOPELESS``); at most ``_EQUALISE`` evaluations for this number of gaps in all."""
         self.following = spans
+        if not self.evaluations:
+            self.start = spans
         while self.evaluations < _EQUALISE and not self.equal:
             spans = self.following
             candidate, widths = evaluate(spans)
@@ -160,12 +163,15 @@ def least_count(
             f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
         )
     spent = sum(t.evaluations for t in tried.values())
-    fewer = tried.get(best - 1)
-    if (  # a miss by the widths' noise, where the mean width would fit
-        fewer is not None and fewer.widest <= _NOISE * width and fewer.widths.mean() <= width
+    fewer, even = tried.get(best - 1), np.full(best - 1, total / (best - 1))
+    if (  # a miss by the widths' noise, where the mean width would fit, not from even spans
+        fewer is not None
+        and fewer.widest <= _NOISE * width
+        and fewer.widths.mean() <= width
+        and not np.allclose(fewer.start, even, rtol=1e-12, atol=0.0)
     ):
         again = _Count()  # another start: lines evenly spaced
-        again.equalise(evaluate, np.full(best - 1, total / (best - 1)), total, width, False)
+        again.equalise(evaluate, even, total, width, False)
         spent += again.evaluations
         if again.widest < fewer.widest:
             tried[best - 1] = again
