@@ -71,6 +71,25 @@ def test_batch_command(tmp_path):
     assert result.exit_code == 2 and "no such file" in result.stderr
 
 
+@pytest.mark.parametrize("command", ["batch", "fabric band"])
+def test_parallel_options_are_checked_alike(tmp_path, command):
+    """``vares batch`` and ``vares fabric band`` take the same --workers/--scheduler: no worker
+    count below 1 (a batch used every core for 0) and not both (the scheduler won silently)."""
+    from pathlib import Path
+
+    fabric = Path(__file__).parents[1] / "examples" / "biaxial" / "pes-batch-42.toml"
+    args = (
+        ("batch", *write_jobs(tmp_path, 1))
+        if command == "batch"
+        else ("fabric", "band", "--example", "hypar", "--fabric", fabric, "-o", tmp_path / "out0")
+    )
+    zero = run(*args, "--workers", 0)
+    assert zero.exit_code == 2 and "--workers must be > 0; got 0" in zero.stderr
+    both = run(*args, "--workers", 2, "--scheduler", "tcp://127.0.0.1:1")
+    assert both.exit_code == 2 and "give --workers or --scheduler, not both" in both.stderr
+    assert not (tmp_path / "out0").exists()  # refused before any work
+
+
 def test_dask_cluster_gives_the_same_patterns_as_local_workers(tmp_path):
     distributed = pytest.importorskip("distributed")
     local, remote = tmp_path / "local", tmp_path / "dask"

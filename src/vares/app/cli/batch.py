@@ -6,25 +6,15 @@ from typing import Annotated
 
 import typer
 
-from .common import console, fail, guarded
+from .common import check_parallel, console, fail, guarded, scheduler_option, workers_option
 
 __all__ = ["batch"]
 
 
 def batch(
     jobs: Annotated[list[Path], typer.Argument(metavar="JOB...", help="Job files (TOML).")],
-    workers: Annotated[
-        int | None,
-        typer.Option("--workers", "-w", help="Local worker processes (default: one per core)."),
-    ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            "--scheduler",
-            help="Run on an existing Dask distributed "
-            "cluster: scheduler address, e.g. tcp://10.0.0.5:8786.",
-        ),
-    ] = None,
+    workers: Annotated[int | None, workers_option("the jobs", "one per core")] = None,
+    scheduler: Annotated[str | None, scheduler_option("the jobs")] = None,
     force: Annotated[
         bool,
         typer.Option("--force", "-f", help="Rerun complete jobs too, replacing their runs."),
@@ -35,6 +25,7 @@ def batch(
     from ..batch import run_batch
 
     def body() -> None:
+        check_parallel(workers, scheduler)
         missing = [str(j) for j in jobs if not j.is_file()]
         if missing:
             raise FileNotFoundError(f"no such file: {', '.join(missing)}")

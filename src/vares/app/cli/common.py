@@ -23,9 +23,46 @@ if TYPE_CHECKING:  # the engine is imported when a command runs, not to build th
     from ..job import Job
     from ..outcome import JobOutcome, PanelOutcome
 
-__all__ = ["console", "execute", "fail", "field_table", "guarded", "refused", "show_erection"]
+__all__ = [
+    "check_parallel",
+    "console",
+    "execute",
+    "fail",
+    "field_table",
+    "guarded",
+    "refused",
+    "scheduler_option",
+    "show_erection",
+    "workers_option",
+]
 
 console = Console(stderr=True, highlight=False, soft_wrap=True)
+
+
+def workers_option(what: str, default: str) -> typer.models.OptionInfo:
+    """The ``--workers`` option of a command that runs ``what`` in parallel (``default`` when
+    it is not given); :func:`check_parallel` checks it."""
+    return typer.Option(
+        "--workers", "-w", help=f"Local worker processes that run {what} (default: {default})."
+    )
+
+
+def scheduler_option(what: str) -> typer.models.OptionInfo:
+    """The ``--scheduler`` option beside :func:`workers_option`."""
+    return typer.Option(
+        "--scheduler",
+        help=f"A Dask distributed scheduler (tcp://host:port, e.g. tcp://10.0.0.5:8786) whose "
+        f"workers run {what}, instead of local processes.",
+    )
+
+
+def check_parallel(workers: int | None, scheduler: str | None) -> None:
+    """Refuse a worker count below 1, and workers beside a scheduler (as a laminate job's
+    options do)."""
+    if workers is not None and workers < 1:
+        raise InputError(f"--workers must be > 0; got {workers}")
+    if workers is not None and scheduler is not None:
+        raise InputError("give --workers or --scheduler, not both")
 
 
 def fail(message: str, code: int) -> int:

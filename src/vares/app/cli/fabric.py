@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .common import console, guarded
+from .common import check_parallel, console, guarded, scheduler_option, workers_option
 from .flags import InputError, flag_name, option_parameter, with_flags
 
 if TYPE_CHECKING:  # the engine is imported when a command runs
@@ -285,13 +285,8 @@ def band(
             help="Erect the nominal patterns with each sample's fabric (the prestress range).",
         ),
     ] = True,
-    workers: Annotated[
-        int | None, typer.Option(help="Local worker processes for the samples (default: 1).")
-    ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(help="A Dask scheduler (tcp://host:port) whose workers solve the samples."),
-    ] = None,
+    workers: Annotated[int | None, workers_option("the samples", "1: in this process")] = None,
+    scheduler: Annotated[str | None, scheduler_option("the samples")] = None,
     output: Annotated[
         Path | None,
         typer.Option(
@@ -337,8 +332,7 @@ def band(
         except OptionsError as exc:
             key = exc.key or ""
             raise InputError(f"--{key.replace('_', '-')} {exc.problem}") from None
-        if workers is not None and workers < 1:
-            raise InputError(f"--workers must be at least 1; got {workers}")
+        check_parallel(workers, scheduler)
         if example is not None:
             source, several = {"example": example}, example in STRUCTURE_EXAMPLES
         elif len(files) == 1:
