@@ -493,3 +493,40 @@ def test_continuation_options_are_refused_where_they_cannot_apply(tmp_path):
     ran = run("pattern", source, "-o", tmp_path / "p", "--yarn-continuation", "1e3,1e2", "-q")
     assert ran.exit_code == 2
     assert "--yarn-continuation must be ascending" in error_line(ran)
+
+
+def test_the_warp_held_above_a_ratio_is_an_option_of_the_solve(tmp_path):
+    """``yarn_align_up_to``: ``vares.solve`` and ``--yarn-align-up-to`` give the pattern of
+    ``solve_yarn_strain(continuation=..., align_up_to=...)``: the warp aligned at the 1e4 stage,
+    its rotation held at 1e6 (the cheaper route on 38,400 cells, docs/locking.md); refused
+    without a continuation."""
+    import meshio
+    from conftest import error_line, run
+
+    import vares
+    from vares.options import OptionsError
+
+    mesh = irregular_cap(100.0, 90.0, 10, 0.3, 1)
+    stiff = OrthotropicStVenantKirchhoff(E1=1e6, E2=1e6, G12=1.0, nu12=0.0)
+    settings = {"yarn_strain": "paired", "yarn_stabilisation": 1e-5, "warp_direction": (1, 0, 0)}
+    held = solve_yarn_strain(mesh, stiff, continuation=(1e4,), align_up_to=1e4, **settings)
+    assert held.converged and [s.aligned for s in held.stages] == [True, False]
+    result = vares.solve(mesh, stiff, yarn_continuation=(1e4,), yarn_align_up_to=1e4, **settings)
+    assert result.converged and result.options.yarn_align_up_to == 1e4
+    np.testing.assert_allclose(result.material_coordinates, held.coordinates, atol=1e-12)
+    aligned = solve_yarn_strain(mesh, stiff, continuation=(1e4,), **settings)
+    assert [s.aligned for s in aligned.stages] == [True, True]
+    source = tmp_path / "cap.obj"
+    meshio.write(source, meshio.Mesh(mesh.points, list(mesh.cells.items())))
+    flags = ["--material", "orthotropic", "--E1", "1e6", "--E2", "1e6", "--G12", "1"]
+    flags += ["--nu12", "0", "--warp-direction", "1,0,0", "--yarn-strain", "paired"]
+    flags += ["--yarn-stabilisation", "1e-5", "--no-previews", "-q"]
+    ran = run("pattern", source, "-o", tmp_path / "p", *flags, "--yarn-continuation", "1e4",
+              "--yarn-align-up-to", "1e4")  # fmt: skip
+    assert ran.exit_code == 0, ran.stderr
+    written = meshio.read(tmp_path / "p" / "pattern.obj").points[:, :2]
+    np.testing.assert_allclose(written, held.coordinates, atol=1e-6)
+    with pytest.raises(OptionsError, match="yarn_continuation"):
+        vares.solve(mesh, stiff, yarn_align_up_to=1e4, **settings)
+    refused = run("pattern", source, "-o", tmp_path / "q", *flags, "--yarn-align-up-to", "1e4")
+    assert refused.exit_code == 2 and "--yarn-align-up-to" in error_line(refused)

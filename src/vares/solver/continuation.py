@@ -90,16 +90,19 @@ def solve_in_stages(
     inverts no cell); the first from ``initial_guess`` (or the options' start). Each stage keeps
     the law's per-cell yarn stiffness ``yarn_stabilisation × E`` (its share ``yarn_stabilisation
     × E / E_stage``, at most :data:`MAX_STAGE_SHARE`). With a warp direction the warp is aligned
-    at the stages of ratio up to ``align_up_to`` (default: every stage); the later ones hold the
-    yarn angle of the last (the pattern comes back with the warp along +x). ``extrapolate``
-    false: every stage from the last pattern (the comparison of docs/locking.md).
+    at the stages of ratio up to ``align_up_to`` (default: ``options.yarn_align_up_to``, else
+    every stage); the later ones hold the yarn angle of the last (the pattern comes back with
+    the warp along +x). ``extrapolate`` false: every stage from the last pattern (the
+    comparison of docs/locking.md).
 
     Returns the law's result, its ``history``, ``steps`` and ``strategy`` those of every stage
     (each record's strategy led by :func:`stage_label`) before its own, ``elapsed`` their sum
     and ``options`` the given ones; and the stages, the law's last.
     """
     ratio, ratios = checked_ratios(material, options.yarn_continuation)
-    base = options.replace(yarn_continuation=())
+    if align_up_to is None:
+        align_up_to = options.yarn_align_up_to
+    base = options.replace(yarn_continuation=(), yarn_align_up_to=None)
     direction = options.warp_direction
     stages: list[ContinuationStage] = []
     history, steps, path = [], [], []

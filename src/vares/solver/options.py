@@ -79,6 +79,15 @@ class SolveOptions(Options):
         "pattern, the law itself last; e.g. 1e2,1e3,1e4,1e5 for E/G = 1e6 (docs/locking.md).",
         section="fibres",
     )
+    yarn_align_up_to: float | None = option(
+        None,
+        "float",
+        "With yarn_continuation and a warp direction: the warp is aligned at the stages of "
+        "ratio up to this one, its rotation held above (default: aligned at every stage); e.g. "
+        "yarn_continuation 1e4 with 1e4 here for E/G = 1e6 (docs/locking.md).",
+        section="fibres",
+        positive=True,
+    )
     strategy: str = option(
         "auto",
         "str",
@@ -142,6 +151,10 @@ class SolveOptions(Options):
         if any(r <= 0.0 for r in ratios) or any(b <= a for a, b in pairwise(ratios)):
             raise OptionsError(
                 "yarn_continuation", f"must be ascending positive ratios; got {list(ratios)}"
+            )
+        if self.yarn_align_up_to is not None and not ratios:
+            raise OptionsError(
+                "yarn_align_up_to", "applies to the stages of a yarn_continuation; none is given"
             )
         if self.warp_direction is not None and self.orientation == "free":
             raise OptionsError(
