@@ -95,6 +95,12 @@ def test_strips_that_cannot_be_paired_are_planned_alone():
     assert "do not get narrower" in alone.pairs_refused
     with pytest.raises(CuttingError):
         choose_plan(planned, "always", None)
+    # planned again narrower (the patterns came out wider than the roll): alone again, and the
+    # reason kept for the cut's notes
+    alone.interlock = False
+    again = SimpleNamespace(compared={}, pairs_refused="")
+    assert choose_plan(lambda interlock: again, "auto", alone) is again
+    assert "do not get narrower" in again.pairs_refused
 
 
 @pytest.mark.parametrize(("even", "strips"), [(0.99, 5), (1.003, 6)])

@@ -199,10 +199,9 @@ def cut(
             f"a per-cell prestress needs one row per cell of the surface ({mesh.num_cells}); "
             f"got {len(prestress)}"
         )
-    target, rounds, paired = usable, [], None
+    target, rounds, plan = usable, [], None
     for _ in range(MAX_ROUNDS):
-        plan = _plan(surface, target, cutting, allowances, options, lines, paired)
-        paired = plan.interlock
+        plan = _plan(surface, target, cutting, allowances, options, lines, plan)
         own = [
             {} if options.warp_direction is not None else {"warp_direction": tuple(w)}
             for w in plan.warps
@@ -356,10 +355,16 @@ def with_patterns(cut_result: CutResult, structure: StructureResult) -> CutResul
 
 
 def _plan(
-    surface, target, cutting: CutOptions, allowances, options, lines, paired: bool | None = None
+    surface,
+    target,
+    cutting: CutOptions,
+    allowances,
+    options,
+    lines,
+    earlier: StripPlan | None = None,
 ) -> StripPlan:
     """The strips: along the user's lines, or planned alone or in pairs (option ``interlock``,
-    :func:`~vares.structures.pairing.choose_plan`; ``paired`` keeps an earlier plan's choice),
+    :func:`~vares.structures.pairing.choose_plan`; an ``earlier`` plan's choice is kept),
     a lone strip of pairs cut across (:func:`~vares.structures.pairing.split_lone_strip`)."""
     if cutting.seams == "curves":
         from ..geometry.drawn_lines import curves_on_surface
@@ -385,7 +390,7 @@ def _plan(
             interlock=interlock,
         )
 
-    return split_lone_strip(choose_plan(planned, cutting.interlock, paired))
+    return split_lone_strip(choose_plan(planned, cutting.interlock, earlier))
 
 
 def piece_outlines(

@@ -27,17 +27,22 @@ __all__ = ["SAVING", "choose_plan", "pair_widths", "split_lone_strip"]
 SAVING = 0.1
 
 
-def choose_plan(planned: Callable[[bool], StripPlan], mode: str, paired: bool | None) -> StripPlan:
+def choose_plan(
+    planned: Callable[[bool], StripPlan], mode: str, earlier: StripPlan | None = None
+) -> StripPlan:
     """The strips alone or in pairs (``planned(interlock)``): as ``mode`` says (``always``,
-    ``never``) or ``paired`` (an earlier plan's choice), else in pairs where, by the flattened
+    ``never``) or as an ``earlier`` plan of the same cut chose (planned again narrower: its
+    ``compared`` and ``pairs_refused`` carried over), else in pairs where, by the flattened
     strips, that saves at least ``SAVING`` of the roll's length (tried only where the strips
     are tapered enough: two need less than 2 (1 − ``SAVING``) times the width of one, one seam
     along the warp; where they cannot be planned in pairs, ``pairs_refused`` of the plan alone
     says why). ``compared`` of the plan gives both estimates (strips, roll length)."""
-    if paired is None and mode != "auto":
-        paired = mode == "always"
-    if paired is not None:
-        return planned(paired)
+    if earlier is not None:
+        plan = planned(earlier.interlock)
+        plan.compared, plan.pairs_refused = dict(earlier.compared), earlier.pairs_refused
+        return plan
+    if mode != "auto":
+        return planned(mode == "always")
     alone = planned(False)
     alone.compared = {"alone": (len(alone.panels), roll_estimate(alone.lengths, 1))}
     if max(alone.straight_pairs) >= 2 * (1 - SAVING) * max(alone.widths):
