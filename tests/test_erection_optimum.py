@@ -289,8 +289,9 @@ def test_an_isometric_pattern_without_prestress_is_left_as_it_is():
 def test_a_structure_is_optimised_with_its_seams_kept_matched():
     """A four-point sail of four strips (PES/PVC, 2/1.5 kN/m, warp across the strips): the
     optimised patterns erect with both mean forces within 0.1 % of the intended, a smaller RMS
-    force deviation and no larger shape deviation, every seam edge equally long in its two
-    patterns (1e-12 of the size), and the results carry the new patterns."""
+    force deviation, a smaller RMS shape deviation and a largest one within the default bound
+    (1.5 × the start's), every seam edge equally long in its two patterns (1e-12 of the size),
+    and the results carry the new patterns."""
     mesh, ids = vares.examples.hypar_strips(strips=4, cells_per_strip=3, n=12)
     structure = vares.solve_structure(
         split_panels(mesh, ids), PES, prestress=(2.0, 1.5), warp_direction=(0.0, 1.0, 0.0)
@@ -303,7 +304,9 @@ def test_a_structure_is_optimised_with_its_seams_kept_matched():
         assert after[yarn]["rms_deviation"] < 0.8 * before[yarn]["rms_deviation"]
     size = np.ptp(mesh.points, axis=0).max()
     assert optimum.history[-1].seam_mismatch < 1e-12 * size
-    assert optimum.erected.deviation()["max"] <= optimum.start.deviation()["max"]
+    start, erected = optimum.start.deviation(), optimum.erected.deviation()
+    assert erected["rms"] < start["rms"]
+    assert erected["max"] <= 1.5 * 1.005 * start["max"]
     results = optimised_results(structure.results, optimum)
     for result, pattern in zip(results, optimum.patterns, strict=True):
         np.testing.assert_array_equal(result.material_coordinates, pattern.material_coordinates)

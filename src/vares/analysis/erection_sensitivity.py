@@ -30,6 +30,7 @@ import numpy as np
 
 from ..mechanics.erection import ErectionProblem, MembraneBlock
 from ..mechanics.forward import deformation_gradients
+from .erection_sensitivity_kernels import chained_points, mixed_derivative
 
 __all__ = [
     "BlockDerivatives",
@@ -189,27 +190,12 @@ def block_derivatives(
     and its derivatives."""
     block, G, w, F, C, S, cc = _points(problem, index, x, True)
     cc = np.broadcast_to(cc, (*C.shape, 2, 2))
-    # δC per pattern dof (b, α): −(G_bβ C_αγ + C_βα G_bγ)
-    GC = np.einsum("mqbx,mqaz->mqbaxz", G, C)
-    dC_X = -(GC + np.swapaxes(GC, -1, -2))
-    dS_X = 0.5 * np.einsum("mqxyuv,mqbauv->mqbaxy", cc, dC_X, optimize=True)
-    FS = F @ S
-    FSG = np.einsum("mqiy,mqay->mqai", FS, G)  # F S G_a
-    dw = w[..., None, None] * G  # δw per (b, α)
-    GSG = np.einsum("mqby,mqcy->mqbc", G @ S, G)
-    FdS = np.einsum("mqiy,mqbayz->mqibaz", F, dS_X)
-    mixed = (
-        np.einsum("mqba,mqci->mciba", dw, FSG)
-        - np.einsum("mqia,mqbc->mciba", w[..., None, None] * F, GSG)
-        + np.einsum("mqibaz,mqcz->mciba", w[..., None, None, None, None] * FdS, G)
-        - np.einsum("mqca,mqbi->mciba", w[..., None, None] * G, FSG)
-    )
+    mixed = mixed_derivative(G, w, F, C, S, cc)
     t = problem.thickness
     forces, by_x, by_X = [], [], []
     for direction in _directions(block):
         n, by_C, by_S = yarn_force_gradients(C, S, direction)  # (m, q), (m, q, 2, 2) ×2
-        D = by_C + 0.5 * np.einsum("mqxy,mqxyuv->mquv", by_S, cc)
-        mean, dn_x, dn_X = _chained(n, D, G, w, F, dC_X, dw, t)
+        mean, dn_x, dn_X = _chained(n, by_C, by_S, cc, G, w, F, C, t)
         forces.append(mean)
         by_x.append(dn_x)
         by_X.append(dn_X)
@@ -219,8 +205,7 @@ def block_derivatives(
         S0 = np.broadcast_to(S0, C.shape)
         cc0 = np.broadcast_to(cc0, (*C.shape, 2, 2))
         m, by_C, by_S = least_force_gradients(C, S0)
-        D = by_C + 0.5 * np.einsum("mqxy,mqxyuv->mquv", by_S, cc0)
-        least, least_by_x, least_by_X = _chained(m, D, G, w, F, dC_X, dw, t)
+        least, least_by_x, least_by_X = _chained(m, by_C, by_S, cc0, G, w, F, C, t)
     return BlockDerivatives(
         mixed,
         np.stack(forces, axis=1),
@@ -232,25 +217,15 @@ def block_derivatives(
     )
 
 
-def _chained(n, D, G, w, F, dC_X, dw, t):
-    """The cell mean ``t Σ_q w n / Σ_q w`` of a point function ``n`` ``(m, q)`` of ``C`` with
-    total derivative ``D = dn/dC`` ``(m, q, 2, 2)``, and its derivatives by the nodes' positions
-    ``(m, nen, 3)`` and by the pattern ``(m, nen, 2)`` (``dC_X``, ``dw`` of the pattern dofs)."""
+def _chained(n, by_C, by_S, cc, G, w, F, C, t):
+    """The cell mean ``t Σ_q w n / Σ_q w`` of a point function ``n`` ``(m, q)`` of ``C`` and
+    ``S`` (partial derivatives ``by_C``, ``by_S``; ``S`` of ``C`` by the tangent ``cc``), and
+    its derivatives by the nodes' positions ``(m, nen, 3)`` and by the pattern ``(m, nen, 2)``
+    (:func:`~vares.analysis.erection_sensitivity_kernels.chained_points`)."""
     total = w.sum(axis=1)
     mean = np.sum(w * n, axis=1) / total
-    # dC by node positions (a, i): G_aβ F_iγ + F_iβ G_aγ
-    DF = np.einsum("mquv,mqiv->mqui", D, F)
-    DtF = np.einsum("mquv,mqiu->mqvi", D, F)
-    dn_x = np.einsum("mqau,mqui->mqai", G, DF + DtF)
-    by_x = t * np.einsum("mq,mqai->mai", w, dn_x) / total[:, None, None]
-    dn_X = np.einsum("mquv,mqbauv->mqba", D, dC_X)
-    by_X = (
-        t
-        * (
-            np.einsum("mqba,mq->mba", dw, n)
-            + np.einsum("mq,mqba->mba", w, dn_X)
-            - mean[:, None, None] * dw.sum(axis=1)
-        )
-        / total[:, None, None]
-    )
-    return t * mean, by_x, by_X
+    by_x, by_X = chained_points(n, by_C, by_S, cc, G, w, F, C)
+    # the mean's weights change with the pattern too: − mean Σ_q δw
+    by_X -= mean[:, None, None] * (w[..., None, None] * G).sum(axis=1)
+    scale = t / total[:, None, None]
+    return t * mean, scale * by_x, scale * by_X
