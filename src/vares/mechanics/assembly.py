@@ -124,17 +124,17 @@ class Assembler:
 
     def matrix(self, hessians: list[np.ndarray]) -> sp.csr_matrix:
         """Global Hessian over the free dofs (CSR) from per-cell ``(m, nen, d, nen, d)`` blocks."""
-        data = np.zeros(self.nnz + 1)
-        start = 0
-        small = not compiled(sum(len(h) for h in hessians))
-        for h in hessians:  # scatter-add block by block, without a concatenated copy
-            values = h.reshape(-1)
-            position = self._position[start : start + values.size]
-            if small:
-                np.add.at(data, position, values)  # in order too: the same sums
-            else:
-                _scatter_add(data, position, values)
-            start += values.size
+        if not compiled(sum(len(h) for h in hessians)):  # small: one weighted count
+            values = np.concatenate([h.reshape(-1) for h in hessians])
+            # bincount adds in order, as the loop below: the same sums
+            data = np.bincount(self._position[: values.size], values, minlength=self.nnz + 1)
+        else:
+            data = np.zeros(self.nnz + 1)
+            start = 0
+            for h in hessians:  # scatter-add block by block, without a concatenated copy
+                values = h.reshape(-1)
+                _scatter_add(data, self._position[start : start + values.size], values)
+                start += values.size
         return sp.csr_matrix(
             (data[:-1], self._indices, self._indptr),
             shape=(self.num_free, self.num_free),
