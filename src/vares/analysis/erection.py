@@ -13,7 +13,7 @@ Supports and edge cables: :mod:`vares.analysis.erection_model`.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -55,6 +55,32 @@ SQUEEZED_MEMBRANE = (
 )
 _ATTEMPTS = (Attempt("erection", None, "line-search"), Attempt("erection, damped", None, "damped"))
 _REGULARISED = tuple(Attempt(f"{a.name}, regularised", a.taus, a.method) for a in _ATTEMPTS)
+
+
+class LazyFields(Mapping[str, np.ndarray]):
+    """Per-cell fields computed when first read (an erection's fields on the design shape:
+    reports read them, the optimiser's trial erections never do)."""
+
+    def __init__(self, compute: Callable[[], dict[str, np.ndarray]]) -> None:
+        self._compute: Callable[[], dict[str, np.ndarray]] | None = compute
+        self._fields: dict[str, np.ndarray] = {}
+
+    def _made(self) -> dict[str, np.ndarray]:
+        if self._compute is not None:
+            self._fields, self._compute = self._compute(), None
+        return self._fields
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        return self._made()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._made())
+
+    def __len__(self) -> int:
+        return len(self._made())
+
+    def __reduce__(self):  # pickled (sent to another process) as the fields themselves
+        return dict, (self._made(),)
 
 
 @dataclass
@@ -110,7 +136,7 @@ class ErectionResult:
     normal_deviation: np.ndarray
     node_areas: np.ndarray
     fields: dict[str, np.ndarray]
-    design_fields: dict[str, np.ndarray]
+    design_fields: Mapping[str, np.ndarray]
     intended: np.ndarray
     held: np.ndarray
     cables: Cables | None = None
@@ -296,11 +322,11 @@ def erect(
         normal_deviation=np.einsum("ni,ni->n", x - design, normals),
         node_areas=node_areas,
         fields=fields,
-        design_fields=_fields(problem, design, structure, relaxed=False),
+        design_fields=LazyFields(lambda: _fields(problem, design, structure, relaxed=False)),
         intended=structure.intended,
         held=held,
         cables=structure.cables,
-        cable_tension=problem.evaluate(x, order=0).cable_tension,
+        cable_tension=problem.cable_tension(x),
         panels=structure.names,
         node_maps=structure.welded.node_maps,
         cell_ids=structure.panel_cells,

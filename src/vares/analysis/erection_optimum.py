@@ -265,7 +265,8 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
     if not converged:
         reason = "no step lowers the objective"
     if erected is not first and TRIAL_TOLERANCE > solver.tolerance:  # trials erected loosely
-        erected = _tightened(current, material, thickness, solver, options, erected)
+        primer = model.tangent_solve if model.linearised else None
+        erected = _tightened(current, material, thickness, solver, options, erected, primer)
     overlap = _overlapping(current)
     if overlap is not None:  # a pattern that laps over itself is no cutting pattern
         current, erected, converged, reason = patterns, first, False, overlap
@@ -397,10 +398,12 @@ def _trial_solver(solver, model, erected, predicted):
     return replace(solver, tolerance=max(solver.tolerance, tolerance))
 
 
-def _tightened(patterns, material, thickness, solver, options, erected):
+def _tightened(patterns, material, thickness, solver, options, erected, primer=None):
     """The erection of the optimised patterns to the solver's tolerance, from their loosely
-    erected state (one or two Newton iterations); that state where this one fails."""
-    tight = _erect(patterns, material, thickness, solver, options, erected.erected_points)
+    erected state (one or two Newton iterations, preconditioned by ``primer``, a solve with the
+    factorised tangent of that state where the optimiser made one); that state where this one
+    fails."""
+    tight = _erect(patterns, material, thickness, solver, options, erected.erected_points, primer)
     return tight if tight.converged else erected
 
 

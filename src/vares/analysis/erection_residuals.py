@@ -284,6 +284,8 @@ class ResidualModel:
         self._normals_by_x = shape_by_x_of(np.ones(n_nodes), normals, n_nodes)[:, kept]
         self.by_X = sp.vstack([self._force_rows @ raw_X, wrinkle @ least_X]).tocsr()
         self.by_x = sp.vstack([self._force_rows @ raw_x, wrinkle @ least_x, shape_by_x]).tocsr()
+        self._force_by_x = self.by_x[: self.num_force]
+        self._shape_by_x = self.by_x[self.num_force :]
         self._by_x_t = self.by_x.T.tocsr()
         self._by_X_t = self.by_X.T.tocsr()
         self._mixed_t = self.mixed.T.tocsr()
@@ -295,6 +297,11 @@ class ResidualModel:
         self.solver = get_solver(self.linear_solver)
         self.solver.factorize(self.tangent)
         self._linear = True
+
+    @property
+    def linearised(self) -> bool:
+        """Whether the derivatives and the factorised tangent of this state are made."""
+        return self._linear is not None
 
     def _tangent_solve(self, rhs: np.ndarray) -> np.ndarray:
         self.solves += 1
@@ -311,8 +318,8 @@ class ResidualModel:
         change ``v`` of the patterns: one solve with ``K``."""
         self.linearise()
         dx = -self._tangent_solve(self.mixed @ v)
-        forces = self.by_X @ v + self.by_x[: self.num_force] @ dx
-        shape = self.by_x[self.num_force :] @ dx
+        forces = self.by_X @ v + self._force_by_x @ dx
+        shape = self._shape_by_x @ dx
         return np.concatenate([forces, shape]), dx
 
     def deviation_change(self, dx: np.ndarray) -> np.ndarray:

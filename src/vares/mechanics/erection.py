@@ -238,6 +238,13 @@ class ErectionProblem:
             tension,
         )
 
+    def cable_tension(self, x: np.ndarray) -> np.ndarray | None:
+        """The force in each cable segment at ``x`` (None without cables)."""
+        if "cables" not in self.connectivity.cells:
+            return None
+        c = self.cables
+        return cable_terms(x[c.segments], c.rest_length, c.stiffness, 0)[3]
+
     def projected_hessians(self, evaluation: ErectionEvaluation) -> list[np.ndarray]:
         """The membrane Hessians made positive semi-definite point by point (with the film's,
         module docs) and the cables' (positive semi-definite already); the pressure's load
