@@ -79,8 +79,16 @@ from .options import ErectionOptions
 
 __all__ = ["OptimisedPatterns", "OptimumRecord", "optimise_for_erection", "optimised_results"]
 
-#: The first damping ``μ``, relative to ``|J|²``; it follows the gain ratio (Nielsen's rule).
+#: The first damping ``μ``, relative to ``|J|²`` on a mesh of DAMPING_NODES nodes or fewer; it
+#: follows the gain ratio (Nielsen's rule). ``|J|²`` is the curvature of the objective's
+#: roughest change of the patterns, the same on every mesh of a surface, while a smooth change's
+#: (what a step mostly is) falls as one over the nodes (its Euclidean norm grows with their
+#: number, its effect on the forces does not): so on finer meshes ``μ`` starts smaller by the
+#: ratio of their nodes, and damps the smooth changes as much as on a mesh of DAMPING_NODES. On
+#: the 50k hypar of ``benchmarks/erection_optimum.py`` the unscaled damping took 7 steps to the
+#: optimum, the scaled 4 (docs/erection.md).
 INITIAL_DAMPING = 1e-3
+DAMPING_NODES = 1000
 #: The trust region of a step: the largest change of a pattern edge's length it may make (a
 #: strain), at first, at most, and below which a refused step's direction is given up.
 INITIAL_STEP_STRAIN = 0.1
@@ -202,7 +210,9 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         lsqr_its = 0
         if step is None:  # a new Levenberg–Marquardt step (after a refused one: shorter)
             if mu is None:
-                mu = INITIAL_DAMPING * _norm_squared(model.operator())
+                nodes = layout.num_variables // 2
+                coarse = min(1.0, DAMPING_NODES / nodes)
+                mu = INITIAL_DAMPING * coarse * _norm_squared(model.operator())
                 preconditioner = stiffness_preconditioner(patterns, material, thickness)
 
             def strain_of(v, at=current):
