@@ -538,3 +538,33 @@ def test_a_drape_beside_a_pattern_lays_the_ply_as_the_patterns_warp_runs(tmp_pat
     warp = np.array(summary["warp"])
     assert abs(abs(warp[0]) - np.sqrt(0.5)) < 0.05 and abs(abs(warp[1]) - np.sqrt(0.5)) < 0.05
     assert summary["against_pattern"]["correlation"] > 0.8
+
+
+def test_a_pattern_job_prints_its_drape_beside_the_pattern(tmp_path):
+    """``vares pattern --drape`` prints the net's producibility table and the pattern's shear
+    against the net's, the same figures as ``summary.json``'s ``kinematic_drape``."""
+    import re
+
+    from conftest import run
+
+    result = run("example", "sail", "-o", tmp_path / "s", "--drape", "--warp-angle", "45")
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((tmp_path / "s" / "summary.json").read_text())["kinematic_drape"]
+    text = result.stdout + result.stderr
+    check = data["producibility"]
+    assert f"producibility (locking {check['locking_angle']:g}°" in text
+    assert f"│ ok    │ < {check['warn_angle']:g}°  │ {100 * check['ok_fraction']:.2f} %" in text
+    line = re.search(r"shear of the pattern against the kinematic drape on (\d+) cells: (.*)", text)
+    assert line is not None, text
+    against = data["against_pattern"]
+    assert int(line.group(1)) == against["cells"]
+    numbers = [float(v) for v in re.findall(r"-?\d+\.\d+", line.group(2))]
+    expected = [
+        against["max_shear"],
+        against["max_kinematic_shear"],
+        against["mean_abs_difference"],
+        against["max_abs_difference"],
+        against["correlation"],
+    ]
+    assert numbers == pytest.approx(expected, abs=0.006)
+    assert f"largest shear {check['max_shear']:.2f}°" in text

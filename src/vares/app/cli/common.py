@@ -245,6 +245,55 @@ def _show_cut(outcome: JobOutcome) -> None:
         )
 
 
+def producibility_table(check) -> Table:
+    """The area of a kinematic drape in each shear class of a
+    :class:`~vares.analysis.producibility.Producibility`."""
+    locking = check.locking_angle
+    table = Table(
+        "class",
+        "shear",
+        "area fraction",
+        title=f"producibility (locking {locking:g}°, warn from {check.warn_angle:g}°)",
+    )
+    bands = {
+        "ok": f"< {check.warn_angle:g}°",
+        "warn": f"{check.warn_angle:g}–{locking:g}°",
+        "limit": f"≥ {locking:g}°",
+    }
+    for name, band in bands.items():
+        table.add_row(name, band, f"{100 * check.fractions[name]:.2f} %")
+    return table
+
+
+def net_line(check, nodes: int, spacing: float) -> str:
+    """What the kinematic net reached: its nodes, the largest shear and the area draped."""
+    return (
+        f"net of {nodes} nodes at spacing {spacing:g}; largest shear {check.max_shear:.2f}°; "
+        f"{100 * check.covered:.1f} % of the area draped"
+    )
+
+
+def _show_drape(panel: PanelOutcome) -> None:
+    """A patterning job's kinematic drape beside its pattern: the net's producibility and the
+    pattern's shear against the net's (``summary.json``'s ``kinematic_drape``)."""
+    ply = panel.drape
+    nodes = int(ply.drape.net.valid.sum())
+    console.print("kinematic drape: " + net_line(ply.producibility, nodes, ply.spacing))
+    console.print(producibility_table(ply.producibility))
+    if not panel.result.converged:
+        return
+    against = ply.comparison(panel.result.fields["shear_angle"], panel.mesh.cell_areas())
+    if against["cells"] < 2:
+        console.print("the pattern and the kinematic drape share no cells to compare")
+        return
+    console.print(
+        f"shear of the pattern against the kinematic drape on {against['cells']} cells: largest "
+        f"{against['max_shear']:.2f}° against {against['max_kinematic_shear']:.2f}°; difference "
+        f"{against['mean_abs_difference']:.2f}° on average (area-weighted), at most "
+        f"{against['max_abs_difference']:.2f}°; correlation {against['correlation']:.3f}"
+    )
+
+
 def show_erection(
     result: ErectionResult, units: str, optimum: OptimisedPatterns | None = None
 ) -> None:
@@ -287,6 +336,8 @@ def show(outcome: JobOutcome) -> None:
         _show_structure(outcome)
     if outcome.cut is not None:
         _show_cut(outcome)
+    if single and outcome.panels[0].drape is not None:
+        _show_drape(outcome.panels[0])
     warnings = outcome.panels[0].warnings if single else outcome.warnings
     if not single:
         warnings = warnings + [

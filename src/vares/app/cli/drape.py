@@ -15,7 +15,7 @@ from ...analysis.dart_options import DartOptions
 from ...analysis.drape_options import DrapeOptions
 from ...units import METRES
 from ..sections import MaterialOptions
-from .common import console, guarded
+from .common import console, guarded, net_line, producibility_table
 from .flags import InputError, build, example_flag, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
@@ -219,7 +219,8 @@ def drape(
         finally:
             folder.discard()
         if not values["quiet"]:
-            _show(check, options.warn_fraction, result.net.valid.sum(), ply.spacing)
+            console.print(producibility_table(check))
+            console.print(net_line(check, result.net.valid.sum(), ply.spacing))
             if darted is not None:
                 _show_darts(darted)
             for path in paths:
@@ -308,28 +309,4 @@ def darts_verdict(darted) -> str:
     return (
         f"largest shear of the pattern {before:.2f}° without darts, {tail}: {state} the "
         f"locking angle ({solves} {'solve' if solves == 1 else 'solves'} with darts)"
-    )
-
-
-def _show(check, warn_fraction: float, nodes: int, spacing: float) -> None:
-    from rich.table import Table
-
-    locking = check.locking_angle
-    table = Table(
-        "class",
-        "shear",
-        "area fraction",
-        title=f"producibility (locking {locking:g}°, warn from {warn_fraction * locking:g}°)",
-    )
-    bands = {
-        "ok": f"< {check.warn_angle:g}°",
-        "warn": f"{check.warn_angle:g}–{locking:g}°",
-        "limit": f"≥ {locking:g}°",
-    }
-    for name, band in bands.items():
-        table.add_row(name, band, f"{100 * check.fractions[name]:.2f} %")
-    console.print(table)
-    console.print(
-        f"net of {nodes} nodes at spacing {spacing:g}; largest shear {check.max_shear:.2f}°; "
-        f"{100 * check.covered:.1f} % of the area draped"
     )
