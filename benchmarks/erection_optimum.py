@@ -7,14 +7,15 @@ iterations on 1.5k, 10k and 50k triangles.
 Surface: ``vares.examples.hypar(size=10, rise=0.06, n=N)`` (2 N² triangles) with the PES/PVC
 type II preset, 2.0/1.5 kN/m, warp along x; default erection (boundary held, tension field) and
 optimiser options (``shape_weight`` 0.1, ``shape_bound`` 1.5, at most 8 steps). For each size,
-in one process after a warm-up on a small mesh: ``vares.solve``, ``vares.erect`` of its pattern,
-and ``vares.optimise_for_erection`` of it (which erects the VaReS pattern again, then per step
-one LSQR solve and the erection of the trial patterns); the ratio optimise / solve is the figure
-asked for (the solve timed as the fastest of ``--solves`` runs). Also printed: the steps,
-LSQR's iterations (two solves with the erection tangent each), the Newton iterations of all
-erections in the optimisation (the start's and the trials') and the objective ``J`` at the
-start and at the end, and the process's CPU time of the solve and of the optimisation (on a
-machine shared with other work the CPU time is the steadier figure; it counts PARDISO's threads).
+in one process after a warm-up on a small mesh (the compiled kernels loaded as well as their
+numpy forms): ``vares.solve``, ``vares.erect`` of its pattern, and
+``vares.optimise_for_erection`` of it (which erects the VaReS pattern again, then per step one
+LSQR solve and the erection of the trial patterns); the ratio optimise / solve is the figure
+asked for (the solve timed as the fastest of ``--solves`` runs). Also printed: the steps, LSQR's
+iterations (two solves with the erection tangent each), the Newton iterations of all erections
+in the optimisation (the start's and the trials') and the objective ``J`` at the start and at
+the end, and the process's CPU time of the solve and of the optimisation (on a machine shared
+with other work the CPU time is the steadier figure; it counts PARDISO's threads).
 
 ``--compare`` runs, for each size and repeat, the optimiser as it was before the trial erections
 were made cheaper and before the compression penalty (:data:`BEFORE`: trials erected to the
@@ -33,6 +34,7 @@ import warnings
 import numpy as np
 
 import vares
+from vares._jit import sized_for
 from vares.analysis import erection_model, erection_optimum, erection_residuals, erection_trials
 from vares.solver.linear import available_solvers
 
@@ -66,8 +68,10 @@ def main() -> None:
     warnings.simplefilter("ignore")
     fabric = vares.materials.fabric("pes-pvc-type-2").material()
     settings = {"prestress": (2.0, 1.5), "warp_direction": (1.0, 0.0, 0.0)}
-    small = vares.solve(vares.examples.hypar(n=6), fabric, linear_solver=solver, **settings)
-    vares.optimise_for_erection(small)  # warm-up: compiled code loaded
+    for compiled in (True, False):  # warm-up: the compiled kernels loaded, and their numpy forms
+        with sized_for(compiled):
+            small = vares.solve(vares.examples.hypar(n=6), fabric, linear_solver=solver, **settings)
+            vares.optimise_for_erection(small)
     print(f"linear solver {solver}; {platform.processor() or platform.machine()}")
     print(
         f"{'triangles':>9} {'variant':>7} {'solve s':>7} {'cpu':>6} {'erect s':>7} "
