@@ -86,6 +86,18 @@ def test_the_numpy_path_keeps_complex_steps():
     np.testing.assert_allclose(numpy.hessian, compiled.hessian, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("d", [2, 3])
+def test_the_assemblers_map_is_the_same_compiled_and_as_numpy(mixed_mesh, d):
+    """The dof pattern and every element entry's slot, with held dofs in first, inner and last
+    rows, for pattern (2) and erected (3) unknowns."""
+    free = np.ones(d * mixed_mesh.num_points, bool)
+    free[[0, 1, 7, 3 * d + 1, d * mixed_mesh.num_points - 1]] = False
+    compiled, numpy = both_paths(lambda: Assembler(mixed_mesh, free, d))
+    assert compiled.nnz == numpy.nnz
+    for name in ("_indices", "_indptr", "_position", "_all_dofs"):
+        np.testing.assert_array_equal(getattr(compiled, name), getattr(numpy, name))
+
+
 def test_assembly_is_the_same_compiled_and_as_numpy(mixed_mesh):
     free = np.ones(2 * mixed_mesh.num_points, bool)
     free[[0, 1, 7]] = False

@@ -65,33 +65,13 @@ class Assembler:
             [entries_of(cells, node_ptr, node_col) for cells in mesh.cells.values()]
         )
 
-        i = np.arange(d)[:, None]
-        j = np.arange(d)[None, :]
-
-        def full_position(entry: np.ndarray) -> np.ndarray:
-            """Position in the full dof CSR of the d × d block (i, j) of node entries."""
-            a = node_row[entry][..., None, None]
-            return d * d * node_ptr[a] + i * d * degree[a] + d * within[entry][..., None, None] + j
-
-        # full dof structure, then keep the free rows and columns
-        rows = (d * node_row[:, None, None] + i + 0 * j).ravel()
-        cols = (d * node_col[:, None, None] + j + 0 * i).ravel()
-        order = full_position(np.arange(node_col.size)).ravel()
-        full_rows = np.empty_like(rows)
-        full_cols = np.empty_like(cols)
-        full_rows[order], full_cols[order] = rows, cols
-        kept = free[full_rows] & free[full_cols]
         reduced = np.full(self.num_dofs, -1, dtype=np.int64)
         reduced[free] = np.arange(self.num_free)
-        self._indices = reduced[full_cols[kept]].astype(np.int32)
-        self._indptr = np.zeros(self.num_free + 1, dtype=np.int64)
-        np.cumsum(
-            np.bincount(reduced[full_rows[kept]], minlength=self.num_free), out=self._indptr[1:]
-        )
-        self.nnz = int(kept.sum())
-
-        # entries in fixed rows or columns go to one extra slot that is dropped
-        target = np.where(kept, np.cumsum(kept) - 1, self.nnz)
+        # the free rows and columns of the full dof structure, and the slot of every full entry
+        # (entries in fixed rows or columns go to one extra slot that is dropped)
+        pattern = _dof_pattern_numpy if small else _dof_pattern
+        self._indices, self._indptr, target = pattern(node_ptr, node_col, free, reduced, d)
+        self.nnz = len(self._indices)
         total = sum(c.shape[0] * (d * c.shape[1]) ** 2 for c in mesh.cells.values())
         self._position = np.empty(total, dtype=np.int64)
         dofs = []
@@ -139,6 +119,71 @@ class Assembler:
             (data[:-1], self._indices, self._indptr),
             shape=(self.num_free, self.num_free),
         )
+
+
+def _dof_pattern_numpy(
+    node_ptr: np.ndarray, node_col: np.ndarray, free: np.ndarray, reduced: np.ndarray, d: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_dof_pattern` as array arithmetic (numpy, for small meshes)."""
+    degree = np.diff(node_ptr)
+    node_row = np.repeat(np.arange(len(node_ptr) - 1), degree)
+    within = np.arange(node_col.size) - node_ptr[node_row]  # rank of b in row a
+    i = np.arange(d)[:, None]
+    j = np.arange(d)[None, :]
+    # position in the full dof CSR of the d × d block (i, j) of each node entry
+    a = node_row[:, None, None]
+    order = (d * d * node_ptr[a] + i * d * degree[a] + d * within[:, None, None] + j).ravel()
+    rows = (d * node_row[:, None, None] + i + 0 * j).ravel()
+    cols = (d * node_col[:, None, None] + j + 0 * i).ravel()
+    full_rows = np.empty_like(rows)
+    full_cols = np.empty_like(cols)
+    full_rows[order], full_cols[order] = rows, cols
+    kept = free[full_rows] & free[full_cols]
+    num_free = int(free.sum())
+    indices = reduced[full_cols[kept]].astype(np.int32)
+    indptr = np.zeros(num_free + 1, dtype=np.int64)
+    np.cumsum(np.bincount(reduced[full_rows[kept]], minlength=num_free), out=indptr[1:])
+    nnz = int(kept.sum())
+    return indices, indptr, np.where(kept, np.cumsum(kept) - 1, nnz)
+
+
+@njit(cache=True)
+def _dof_pattern(node_ptr, node_col, free, reduced, d):  # pragma: no cover - compiled
+    """The CSR structure (column indices, row pointer) of the matrix over the ``free`` dofs
+    (``reduced``: a dof's index among them, −1 if held) and the slot in it of every entry of the
+    full dof structure (rows ``d a + i`` in order, in each the node pattern's columns ``b`` in
+    order, each as ``d b + j``), ``nnz`` for an entry in a held row or column."""
+    n = len(node_ptr) - 1
+    total = d * d * node_ptr[n]
+    target = np.empty(total, dtype=np.int64)
+    indices = np.empty(total, dtype=np.int32)
+    num_free = 0
+    for k in range(free.size):
+        num_free += free[k]
+    indptr = np.zeros(num_free + 1, dtype=np.int64)
+    k = 0  # position in the full structure
+    r = 0  # slot in the reduced one
+    for a in range(n):
+        for i in range(d):
+            row = d * a + i
+            row_free = free[row]
+            for p in range(node_ptr[a], node_ptr[a + 1]):
+                b = node_col[p]
+                for j in range(d):
+                    column = d * b + j
+                    if row_free and free[column]:
+                        target[k] = r
+                        indices[r] = reduced[column]
+                        r += 1
+                    else:
+                        target[k] = -1
+                    k += 1
+            if row_free:
+                indptr[reduced[row] + 1] = r
+    for k in range(total):
+        if target[k] < 0:
+            target[k] = r
+    return indices[:r].copy(), indptr, target
 
 
 def _node_pattern(mesh: SurfaceMesh | Connectivity) -> tuple[np.ndarray, np.ndarray]:
