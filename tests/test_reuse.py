@@ -11,6 +11,7 @@ import vares
 from vares import examples
 from vares.solver import linear
 from vares.solver.reuse import (
+    CAUTIOUS_BELOW,
     ETA_MAX,
     ETA_MAX_KINKED,
     ReusingSolver,
@@ -99,6 +100,64 @@ def test_reusing_solver_factorises_only_when_it_must():
     x = solver.solve(far, rhs[: far.shape[0]], rtol=1e-10)
     assert solver.factorisations == 4 and solver.cg_iterations > iterations
     np.testing.assert_allclose(far @ x, rhs[: far.shape[0]], atol=1e-9 * np.linalg.norm(rhs))
+
+
+class _Cautious(linear.SuperLUSolver):
+    """SuperLU that reuses its factorisation as PARDISO does: cautiously, within 3 iterations."""
+
+    reuse_iterations = 3
+    cautious_reuse = True
+
+
+def test_a_cautious_solver_reuses_only_at_newtons_end_for_the_same_kind_and_until_it_fails():
+    """A back end whose factorisation is cheap (PARDISO) reuses it only for steps asked to
+    better than CAUTIOUS_BELOW, only for a tangent of the kind it factorised (Newton's exact
+    tangents come with ``definite=True``), and not again once conjugate gradients failed."""
+    solver = ReusingSolver(_Cautious())
+    matrix = _laplacian(16)
+    rng = np.random.default_rng(4)
+    rhs = rng.standard_normal(matrix.shape[0])
+    near = (matrix + sp.diags(rng.uniform(0.0, 0.01, matrix.shape[0]))).tocsr()
+    solver.solve(matrix, rhs, rtol=1e-3, definite=True)
+    assert (solver.factorisations, solver.cg_iterations) == (1, 0)
+    solver.solve(near, rhs, rtol=2 * CAUTIOUS_BELOW, definite=True)  # a loose, early step
+    assert (solver.factorisations, solver.cg_iterations) == (2, 0)
+    x = solver.solve(near, rhs, rtol=1e-6, definite=True)  # Newton's end: reused
+    assert solver.factorisations == 2 and 0 < solver.cg_iterations <= 3
+    assert np.linalg.norm(rhs - near @ x) <= 1e-6 * np.linalg.norm(rhs)
+    solver.solve(near, rhs, rtol=1e-6, definite=False)  # a projected tangent after an exact one
+    assert solver.factorisations == 3
+    used = solver.cg_iterations
+    far = (matrix + sp.diags(rng.uniform(0.0, 40.0, matrix.shape[0]))).tocsr()
+    solver.solve(far, rhs, rtol=1e-10, definite=False)  # too far: CG gives up, factorised
+    assert solver.factorisations == 4 and solver.cg_iterations > used
+    used = solver.cg_iterations
+    solver.solve(far, rhs, rtol=1e-3, definite=False)  # would reuse, but no longer tries
+    assert (solver.factorisations, solver.cg_iterations) == (5, used)
+
+
+def test_pardiso_reuses_its_factorisation_at_newtons_end_for_the_same_pattern():
+    """On the 100k race's hypar, smaller (20k triangles): the last Newton steps by conjugate
+    gradients preconditioned by the first exact tangent's factorisation, the same optimum as
+    with every tangent factorised."""
+    if "pardiso" not in linear.available_solvers():
+        pytest.skip("PARDISO is not installed")
+    mesh = examples.hypar(size=10.0, rise=0.06, n=100)
+    law = vares.materials.StVenantKirchhoff(1000.0, 0.3)
+    reused = vares.solve(mesh, law, tolerance=1e-10, linear_solver="pardiso")
+    every = linear.PardisoSolver.reuse_iterations
+    try:
+        linear.PardisoSolver.reuse_iterations = 0
+        reference = vares.solve(mesh, law, tolerance=1e-10, linear_solver="pardiso")
+    finally:
+        linear.PardisoSolver.reuse_iterations = every
+    assert reference.factorisations == reference.iterations and reference.cg_iterations == 0
+    assert reused.iterations == reference.iterations
+    assert reused.factorisations < reference.factorisations and reused.cg_iterations > 0
+    assert reused.energy == pytest.approx(reference.energy, rel=1e-12)
+    np.testing.assert_allclose(
+        reused.material_coordinates, reference.material_coordinates, atol=1e-9 * 10.0
+    )
 
 
 def test_a_solver_that_never_reuses_factorises_every_system():

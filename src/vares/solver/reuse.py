@@ -26,7 +26,14 @@ import scipy.sparse as sp
 
 from .linear import LinearSolver
 
-__all__ = ["ETA_MAX", "ETA_MAX_KINKED", "ReusingSolver", "forcing_term", "preconditioned_cg"]
+__all__ = [
+    "CAUTIOUS_BELOW",
+    "ETA_MAX",
+    "ETA_MAX_KINKED",
+    "ReusingSolver",
+    "forcing_term",
+    "preconditioned_cg",
+]
 
 #: The loosest relative accuracy a Newton step is solved to (a smooth energy's).
 ETA_MAX = 0.1
@@ -35,6 +42,12 @@ ETA_MAX = 0.1
 #: at its cap; steps solved to 0.1 then took 1.3–2× the iterations (and 1.4–1.6× the time) of
 #: steps solved to 1e-3 with SuperLU (docs/erection.md), which cost a few CG iterations more.
 ETA_MAX_KINKED = 1e-3
+#: A back end whose factorisation costs few solves (``cautious_reuse``: PARDISO) reuses it only
+#: for steps asked to better than this (Newton's fast end, where the tangents barely move), only
+#: for a tangent of the kind it factorised (exact or projected), and never again in a sequence
+#: once conjugate gradients failed. The 100k hypar's last two Newton steps then take 3 and 1
+#: conjugate-gradient iterations instead of two factorisations (docs/benchmarks.md).
+CAUTIOUS_BELOW = 0.05
 
 
 def forcing_term(residuals: list[float], tolerance: float, loosest: float = ETA_MAX) -> float:
@@ -134,6 +147,7 @@ class ReusingSolver:
         self._size: int | None = None
         self._primer: Callable[[np.ndarray], np.ndarray] | None = None
         self._primer_budget = 0
+        self._definite = False  # of the matrix factorised last (Newton's exact tangents: True)
         #: numeric factorisations and conjugate-gradient iterations so far (failed ones too)
         self.factorisations = 0
         self.cg_iterations = 0
@@ -169,11 +183,15 @@ class ReusingSolver:
             if x is not None:
                 return x
             self._primer = None  # the systems have moved too far from the primer's matrix
-        if rtol > 0 and self.budget > 0 and self._size == size:
+        cautious = getattr(self.solver, "cautious_reuse", False)
+        reusable = not cautious or (rtol <= CAUTIOUS_BELOW and definite == self._definite)
+        if rtol > 0 and reusable and self.budget > 0 and self._size == size:
             x, iterations = preconditioned_cg(matrix, rhs, solve, rtol, self.budget, constraint)
             self.cg_iterations += iterations
             if x is not None:
                 return x
+            if cautious:
+                self.budget = 0  # the tangents move too much: factorise from now on
         if constraint is None:
             return self.exact(matrix, rhs, definite)
         column = sp.csr_matrix(constraint[:, None])
@@ -185,5 +203,5 @@ class ReusingSolver:
         self._size, self._primer = None, None
         self.factorisations += 1
         self.solver.factorize(matrix, definite=definite)
-        self._size = matrix.shape[0]
+        self._size, self._definite = matrix.shape[0], definite
         return self.solver.solve(rhs)
