@@ -8,8 +8,9 @@ the factorisation of an earlier one is an excellent preconditioner for conjugate
 the next: on the 100k-triangle hypar each CG iteration cuts the error tenfold, and a Newton
 step needs two to four of them instead of a new factorisation. For back ends whose
 factorisation costs many solves (CHOLMOD, SuperLU: 15–30 solves) that replaces all but the
-first factorisation; PARDISO factorises in about four solves' time and factorises every
-tangent (docs/benchmarks.md).
+first factorisation; PARDISO factorises in about four solves' time and reuses its
+factorisation only cautiously (:data:`CAUTIOUS_BELOW`), at Newton's fast end
+(docs/benchmarks.md).
 
 Conjugate gradients are written out here rather than taken from SciPy: the iteration must stop
 as soon as it meets a direction of non-positive curvature (an indefinite tangent must be
