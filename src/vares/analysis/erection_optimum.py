@@ -274,7 +274,7 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         converged = True  # every step taken lowered the objective: the patterns are usable
     if not converged:
         reason = "no step lowers the objective"
-    if erected is not first and TRIAL_TOLERANCE > solver.tolerance:  # trials erected loosely
+    if erected is not first and not _tight(erected, solver):  # trials erected loosely
         primer = model.tangent_solve if model.linearised else None
         erected = _tightened(current, material, thickness, solver, options, erected, primer)
     overlap = _overlapping(current)
@@ -406,6 +406,12 @@ def _trial_solver(solver, model, erected, predicted):
     bound = ACCEPTANCE_ACCURACY * predicted / (2.0 * model.equilibrium_sensitivity())
     tolerance = min(TRIAL_TOLERANCE, bound / erected.problem.force_scale)
     return replace(solver, tolerance=max(solver.tolerance, tolerance))
+
+
+def _tight(erected, solver) -> bool:
+    """Whether an erection's last iterate meets the solver's own tolerance (a trial's erection,
+    asked for less, may have met it anyway: then it is the optimum's final erection)."""
+    return bool(erected.history) and erected.history[-1].relative_residual <= solver.tolerance
 
 
 def _tightened(patterns, material, thickness, solver, options, erected, primer=None):
