@@ -113,8 +113,7 @@ def row(mesh, variant: str, optimum, times) -> None:
     lsqr = sum(r.lsqr_iterations for r in optimum.history)
     # every erection's Newton iterations: the start's, the trials' and the optimum's tightening
     newton = optimum.start.iterations + sum(r.erection_iterations for r in optimum.history)
-    if optimum.erected is not optimum.start and erection_optimum.TRIAL_TOLERANCE > 0:
-        newton += optimum.erected.iterations
+    newton += optimum.tightening or 0
     objective = f"{optimum.history[0].objective:.3f}→{optimum.history[-1].objective:.4f}"
 
     def pair(key, yarn, a=before, b=after):

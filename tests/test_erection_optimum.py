@@ -495,3 +495,4 @@ def test_the_optimum_is_erected_to_the_full_tolerance_whether_or_not_its_trial_w
     for loose in calls:  # re-erected only from a state that did not meet it
         assert loose.history[-1].relative_residual > tolerance
     assert bool(calls) == (trials is None)
+    assert (result.tightening is not None) == bool(calls)  # the iterations of re-erecting it

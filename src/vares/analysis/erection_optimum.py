@@ -274,9 +274,11 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         converged = True  # every step taken lowered the objective: the patterns are usable
     if not converged:
         reason = "no step lowers the objective"
+    tightening = None
     if erected is not first and not _tight(erected, solver):  # trials erected loosely
         primer = model.tangent_solve if model.linearised else None
-        erected = _tightened(current, material, thickness, solver, options, erected, primer)
+        tight = _tightened(current, material, thickness, solver, options, erected, primer)
+        tightening, erected = (tight.iterations if tight is not erected else None), tight
     overlap = _overlapping(current)
     if overlap is not None:  # a pattern that laps over itself is no cutting pattern
         current, erected, converged, reason = patterns, first, False, overlap
@@ -290,6 +292,7 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
         shape_weight,
         shape_bound,
         elapsed=time.perf_counter() - started,
+        tightening=None if current is patterns else tightening,
     )
 
 

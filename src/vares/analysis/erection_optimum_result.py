@@ -43,7 +43,9 @@ class OptimumRecord:
 @dataclass
 class OptimisedPatterns:
     """The optimised patterns (one :class:`Pattern` per panel, as given), the erections of the
-    starting and of the optimised patterns, the iterations and why it stopped."""
+    starting and of the optimised patterns, the iterations and why it stopped; ``tightening``:
+    the Newton iterations of erecting the optimum again to the full tolerance (None where its
+    trial's erection already met it, or nothing was optimised)."""
 
     patterns: list[Pattern]
     start: ErectionResult
@@ -54,6 +56,7 @@ class OptimisedPatterns:
     shape_weight: float
     shape_bound: float | None = None
     elapsed: float = 0.0
+    tightening: int | None = None
 
     @property
     def iterations(self) -> int:
