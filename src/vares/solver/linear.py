@@ -54,7 +54,9 @@ class IndefiniteMatrixError(SingularMatrixError):
 class LinearSolver(Protocol):
     """Factorise a sparse symmetric matrix, then solve with it. ``reuse_iterations``: how
     many conjugate-gradient iterations preconditioned by the last factorisation may stand in
-    for a new one (:mod:`vares.solver.reuse`; about what a factorisation costs in solves).
+    for a new one (:mod:`vares.solver.reuse`; about what a factorisation costs in solves);
+    a back end may set ``cautious_reuse`` (PARDISO) to reuse only at Newton's fast end
+    (:data:`vares.solver.reuse.CAUTIOUS_BELOW`).
     ``factorize(matrix, definite=True)``: the caller would rather have
     :class:`IndefiniteMatrixError` than a slow factorisation of an indefinite matrix (a
     solver that handles indefinite matrices as fast may ignore it)."""
