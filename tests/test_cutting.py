@@ -428,3 +428,21 @@ def test_strips_in_pairs_are_refined_for_their_own_width():
     assert longest_edge(alone.cut.mesh) > 4.0 / (2 * CELLS_ACROSS)  # no finer than it needs
     assert longest_edge(paired.cut.mesh) <= 4.0 / (2 * CELLS_ACROSS)
     assert paired.refinements == alone.refinements + 1
+
+
+def test_a_surface_narrower_than_the_roll_is_cut_as_one_strip(tmp_path):
+    """The saddle (20 m, a 100 m roll): one strip, no seam, the whole surface on the roll (it
+    failed in the search for the number of strips, then in the seams' line lengths)."""
+    import json
+
+    from conftest import run
+
+    out = tmp_path / "one"
+    result = run("cut", "--example", "saddle", "--roll-width", "100", "-o", out, "-q")
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "cut.json").read_text())
+    assert len(data["panels"]) == 1 and data["seams"] == []
+    assert data["panels"][0]["width"] <= 100.0
+    structure = json.loads((out / "structure.json").read_text())
+    assert structure["converged"] and structure["seams"] == [] and not structure["too_wide"]
+    assert data["nesting"]["length"] == pytest.approx(data["panels"][0]["width"], rel=0.05)

@@ -165,3 +165,12 @@ def test_a_miss_from_even_spans_is_not_started_evenly_again():
 
     plan = least_count(scripted, 1.0, 6, 1, 1.0, 200, False)
     assert len(plan.widths) == 6 and calls.count(5) == 6  # its own six evaluations, no more
+
+
+def test_a_surface_that_fits_one_strip_is_one_strip():
+    """A roll wider than the whole surface (2 in all at 2.5): one gap, found at once; there is
+    no fewer to try again (the parameter span a plain float, as a user's family gives it)."""
+    calls: list[int] = []
+    plan = least_count(density_model(calls), 1.0, 1, 1, 2.5, 200, False)
+    assert calls == [1] and max(plan.widths) == pytest.approx(2.0)
+    assert plan.history == [(1, pytest.approx(2.0))]

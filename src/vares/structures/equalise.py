@@ -163,7 +163,8 @@ def least_count(
             f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
         )
     spent = sum(t.evaluations for t in tried.values())
-    fewer, even = tried.get(best - 1), np.full(best - 1, total / (best - 1))
+    fewer = tried.get(best - 1)  # None where one gap fits (no fewer) or fewer were not tried
+    even = None if fewer is None else np.full(best - 1, total / (best - 1))
     if (  # a miss by the widths' noise, where the mean width would fit, not from even spans
         fewer is not None
         and fewer.widest <= _NOISE * width

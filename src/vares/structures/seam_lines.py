@@ -46,8 +46,10 @@ def seam_lines(plan: StripPlan, structure: StructureResult) -> list[SeamLine]:
     from scipy.spatial import cKDTree
 
     chains = [plan.cut.mesh.points[c] for c in plan.cut.lines]
-    owner = np.concatenate([np.full(len(c), k) for k, c in enumerate(chains)])
-    tree = cKDTree(np.vstack(chains)) if chains else None
+    tree = owner = None  # one strip: no cutting line to follow
+    if chains:
+        owner = np.concatenate([np.full(len(c), k) for k, c in enumerate(chains)])
+        tree = cKDTree(np.vstack(chains))
     out = []
     for seam, report in zip(structure.seams, structure.seam_reports, strict=True):
         nodes = structure.panels[seam.first].mesh.points[seam.nodes_first]

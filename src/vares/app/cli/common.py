@@ -195,6 +195,16 @@ def _show_panel(panel: PanelOutcome, detail: bool) -> None:
 
 def _show_structure(outcome: JobOutcome) -> None:
     structure = outcome.structure
+    if structure.seams:
+        console.print(_seam_table(structure))
+    console.print(
+        f"{len(outcome.panels)} panels, {len(structure.seams)} seams, "
+        f"{structure.iterations} coupled iterations; energy {structure.energy:.6e}, price of "
+        f"matching {structure.energy_price:.3e}; {structure.elapsed:.2f} s"
+    )
+
+
+def _seam_table(structure) -> Table:
     table = Table(
         "seam",
         "segments",
@@ -213,12 +223,7 @@ def _show_structure(outcome: JobOutcome) -> None:
             f"{s.mismatch_before:.2e}",
             f"{s.mismatch_after:.2e}",
         )
-    console.print(table)
-    console.print(
-        f"{len(outcome.panels)} panels, {len(structure.seams)} seams, "
-        f"{structure.iterations} coupled iterations; energy {structure.energy:.6e}, price of "
-        f"matching {structure.energy_price:.3e}; {structure.elapsed:.2f} s"
-    )
+    return table
 
 
 def _show_cut(outcome: JobOutcome) -> None:
