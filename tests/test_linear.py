@@ -3,6 +3,8 @@ threads."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -50,6 +52,20 @@ def test_upper_triangle_map_of_a_matrix_with_its_whole_diagonal():
     index, indptr, indices = linear._upper_triangle_map(matrix)
     assert np.all(index >= 0) and np.all(np.diff(index) > 0)
     upper = sp.csr_matrix((matrix.data[index], indices, indptr), shape=matrix.shape)
+    np.testing.assert_array_equal(upper.toarray(), np.triu(matrix.toarray()))
+    # the same matrix with its columns out of order in every row: the map sorts them
+    shuffled = sp.csr_matrix(
+        (matrix.data.copy(), matrix.indices.copy(), matrix.indptr.copy()), shape=matrix.shape
+    )
+    for a, b in zip(shuffled.indptr[:-1], shuffled.indptr[1:], strict=True):
+        shuffled.indices[a:b], shuffled.data[a:b] = (
+            shuffled.indices[a:b][::-1],
+            shuffled.data[a:b][::-1],
+        )
+    shuffled.has_sorted_indices = False
+    index, indptr, indices = linear._upper_triangle_map(shuffled)
+    assert all(np.all(np.diff(indices[a:b]) > 0) for a, b in itertools.pairwise(indptr))
+    upper = sp.csr_matrix((shuffled.data[index], indices, indptr), shape=matrix.shape)
     np.testing.assert_array_equal(upper.toarray(), np.triu(matrix.toarray()))
 
 

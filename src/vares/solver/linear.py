@@ -306,8 +306,9 @@ def _point_pypardiso_at_mkl() -> None:
 
 
 def _upper_triangle_map(matrix: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For a CSR matrix with sorted indices, the upper triangle with every diagonal entry
-    stored: ``(index, indptr, indices)`` where ``upper.data = append(matrix.data, 0)[index]``."""
+    """The upper triangle of a CSR matrix with every diagonal entry stored, its columns sorted
+    in every row: ``(index, indptr, indices)`` where ``upper.data = append(matrix.data,
+    0)[index]``."""
     n = matrix.shape[0]
     rows = np.repeat(np.arange(n), np.diff(matrix.indptr))
     keep = np.flatnonzero(matrix.indices >= rows)
@@ -315,7 +316,7 @@ def _upper_triangle_map(matrix: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, 
     has_diagonal[rows[keep][matrix.indices[keep] == rows[keep]]] = True
     missing = np.flatnonzero(~has_diagonal)
     indptr = np.zeros(n + 1, dtype=np.int64)
-    if not missing.size:  # the kept entries are in row order, their columns sorted already
+    if not missing.size and matrix.has_sorted_indices:  # the kept entries in order already
         np.cumsum(np.bincount(rows[keep], minlength=n), out=indptr[1:])
         return keep, indptr, matrix.indices[keep]
     all_rows = np.concatenate([rows[keep], missing])
