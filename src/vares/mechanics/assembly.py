@@ -70,7 +70,9 @@ class Assembler:
         # the free rows and columns of the full dof structure, and the slot of every full entry
         # (entries in fixed rows or columns go to one extra slot that is dropped)
         pattern = _dof_pattern_numpy if small else _dof_pattern
-        self._indices, self._indptr, target = pattern(node_ptr, node_col, free, reduced, d)
+        self._indices, self._indptr, target = pattern(
+            node_ptr, node_col, free, reduced, self.num_free, d
+        )
         self.nnz = len(self._indices)
         total = sum(c.shape[0] * (d * c.shape[1]) ** 2 for c in mesh.cells.values())
         self._position = np.empty(total, dtype=np.int64)
@@ -122,7 +124,12 @@ class Assembler:
 
 
 def _dof_pattern_numpy(
-    node_ptr: np.ndarray, node_col: np.ndarray, free: np.ndarray, reduced: np.ndarray, d: int
+    node_ptr: np.ndarray,
+    node_col: np.ndarray,
+    free: np.ndarray,
+    reduced: np.ndarray,
+    num_free: int,
+    d: int,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`_dof_pattern` as array arithmetic (numpy, for small meshes)."""
     degree = np.diff(node_ptr)
@@ -139,7 +146,6 @@ def _dof_pattern_numpy(
     full_cols = np.empty_like(cols)
     full_rows[order], full_cols[order] = rows, cols
     kept = free[full_rows] & free[full_cols]
-    num_free = int(free.sum())
     indices = reduced[full_cols[kept]].astype(np.int32)
     indptr = np.zeros(num_free + 1, dtype=np.int64)
     np.cumsum(np.bincount(reduced[full_rows[kept]], minlength=num_free), out=indptr[1:])
@@ -148,18 +154,16 @@ def _dof_pattern_numpy(
 
 
 @njit(cache=True)
-def _dof_pattern(node_ptr, node_col, free, reduced, d):  # pragma: no cover - compiled
+def _dof_pattern(node_ptr, node_col, free, reduced, num_free, d):  # pragma: no cover
     """The CSR structure (column indices, row pointer) of the matrix over the ``free`` dofs
-    (``reduced``: a dof's index among them, −1 if held) and the slot in it of every entry of the
-    full dof structure (rows ``d a + i`` in order, in each the node pattern's columns ``b`` in
-    order, each as ``d b + j``), ``nnz`` for an entry in a held row or column."""
+    (``reduced``: a dof's index among them, −1 if held; ``num_free`` of them) and the slot in it
+    of every entry of the full dof structure (rows ``d a + i`` in order, in each the node
+    pattern's columns ``b`` in order, each as ``d b + j``), ``nnz`` for an entry in a held row
+    or column."""
     n = len(node_ptr) - 1
     total = d * d * node_ptr[n]
     target = np.empty(total, dtype=np.int64)
     indices = np.empty(total, dtype=np.int32)
-    num_free = 0
-    for k in range(free.size):
-        num_free += free[k]
     indptr = np.zeros(num_free + 1, dtype=np.int64)
     k = 0  # position in the full structure
     r = 0  # slot in the reduced one
