@@ -396,16 +396,17 @@ def test_continuation_reaches_yarn_to_shear_1e6_from_the_default_start_without_l
 
 def test_continuation_takes_a_fraction_of_the_iterations_of_the_direct_stiff_solve():
     """A cap of 600 cells at E/G = 1e6, pairs of nodes, warp aligned, the default start: solved
-    directly it takes hundreds of iterations (measured 449, converged; 877 and not converged
-    on 2026-12-02's main); through the decades 1e2 … 1e5 45 (13 + 16 + 8 + 5 + 3), through 1e2
-    and 1e4 64 (13 + 36 + 15; the last stage from the extrapolation of the two)."""
+    directly it takes over a hundred iterations (measured 113; 449 before the switch to the exact
+    tangent was moved down with the law's softness, 877 and not converged on an earlier main);
+    through the decades 1e2 … 1e5 34 (13 + 7 + 6 + 5 + 3; 45 before)."""
     mesh = irregular_cap(100.0, 90.0, 10, 0.3, 1)
     stiff = OrthotropicStVenantKirchhoff(E1=1e6, E2=1e6, G12=1.0, nu12=0.0)
     settings = {"yarn_strain": "paired", "yarn_stabilisation": 1e-5, "warp_direction": (1, 0, 0)}
     staged = solve_yarn_strain(mesh, stiff, continuation=DECADES, **settings)
-    assert staged.converged and staged.iterations < 60
+    assert staged.converged and staged.iterations < 45
     direct = solve_yarn_strain(mesh, stiff, **settings)
-    assert direct.iterations > 4 * staged.iterations
+    assert direct.converged
+    assert direct.iterations > 2 * staged.iterations
 
 
 def test_the_continuation_is_an_option_of_the_api_job_files_and_command_line(tmp_path):
@@ -530,3 +531,50 @@ def test_the_warp_held_above_a_ratio_is_an_option_of_the_solve(tmp_path):
         vares.solve(mesh, stiff, yarn_align_up_to=1e4, **settings)
     refused = run("pattern", source, "-o", tmp_path / "q", *flags, "--yarn-align-up-to", "1e4")
     assert refused.exit_code == 2 and "--yarn-align-up-to" in error_line(refused)
+
+
+def test_the_softness_of_a_law_is_its_softest_small_strain_stiffness_over_its_scale():
+    """Isotropic laws: 2μ over E = 1/(1 + ν); orthotropic: 2 G12 over the larger yarn modulus;
+    the switch to the exact tangent moves down in proportion below SOFTNESS_REFERENCE only."""
+    from vares.materials import NeoHooke, StVenantKirchhoff
+    from vares.solver.newton import EXACT_TANGENT_BELOW, SOFTNESS_REFERENCE, exact_tangent_below
+
+    warp = Fibres.from_angles(30.0)
+    assert StVenantKirchhoff(1000.0, 0.3).softness() == pytest.approx(1 / 1.3, rel=1e-12)
+    assert NeoHooke(1000.0, 0.3).softness() == pytest.approx(1 / 1.3, rel=1e-12)
+    woven = OrthotropicStVenantKirchhoff(E1=1e4, E2=5e3, G12=1.0, nu12=0.0)
+    assert woven.softness(warp) == pytest.approx(2e-4, rel=1e-9)  # turned yarns: the same
+    assert exact_tangent_below(0.5) == EXACT_TANGENT_BELOW
+    assert exact_tangent_below(SOFTNESS_REFERENCE) == EXACT_TANGENT_BELOW
+    assert exact_tangent_below(2e-4) == pytest.approx(EXACT_TANGENT_BELOW * 2e-4 / 0.05)
+    assert exact_tangent_below(float("nan")) == EXACT_TANGENT_BELOW
+
+
+def test_newton_stays_fast_with_stiff_locking_free_yarns():
+    """The 2,400-cell hemisphere from the kinematic net's pattern, pairs of nodes, warp aligned:
+    E/G = 1e4 in 16 iterations and 1e6 solved directly in 40 (48 and 126 while the exact tangent
+    was taken from a relative residual of 1e-2 whatever the law's softness: its steps along the
+    shear modes were cut to 0.01–0.5 by the line search), the four meridians of both within
+    0.05° of each other's (the pairs do not lock at 1e6)."""
+    mesh = irregular_cap(100.0, 90.0, 20, 0.3, 1)
+    start = kinematic_drape(
+        mesh, seed=(0, 0, 100), warp_direction=(1, 0, 0), spacing=1.0
+    ).material_coordinates
+    tables = []
+    for ratio, most in ((1e4, 25), (1e6, 60)):
+        law = OrthotropicStVenantKirchhoff(E1=ratio, E2=ratio, G12=1.0, nu12=0.0)
+        result = solve_yarn_strain(
+            mesh,
+            law,
+            yarn_strain="paired",
+            yarn_stabilisation=10.0 / ratio,
+            warp_direction=(1, 0, 0),
+            initial_guess=start,
+        )
+        assert result.converged
+        assert result.iterations < most
+        tables.append(
+            meridian_shear(mesh, cell_shear_angle(mesh, result.coordinates, law, result.fibres))
+        )
+    assert np.abs(tables[0] - tables[1]).max() < 0.05
+    assert np.abs(tables[0] - NET).max() < 2.0

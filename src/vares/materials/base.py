@@ -154,6 +154,28 @@ class Hyperelastic(ABC):
     def stiffness_scale(self) -> float:
         """A representative small-strain stiffness (stress units), used to scale tolerances."""
 
+    def softness(self, fibres: Fibres | None = None) -> float:
+        """The smallest eigenvalue of the small-strain stiffness ``ℂ`` at ``C = I`` (in Mandel
+        form, so that a shear and a stretch of the same size count alike) over
+        :attr:`stiffness_scale`: about 0.5–0.8 for an isotropic law, the shear over the yarn
+        modulus for a fabric (2e-4 for yarns 10,000 times stiffer than the shear). ``nan`` where
+        ``ℂ`` cannot be evaluated there."""
+        try:
+            c = self.response(np.eye(2)[None], fibres, tangent=True).tangent[0]
+        except (ValueError, ArithmeticError):  # MaterialError is a ValueError
+            return float("nan")
+        root = np.sqrt(2.0)
+        mandel = np.array(
+            [
+                [c[0, 0, 0, 0], c[0, 0, 1, 1], root * c[0, 0, 0, 1]],
+                [c[1, 1, 0, 0], c[1, 1, 1, 1], root * c[1, 1, 0, 1]],
+                [root * c[0, 1, 0, 0], root * c[0, 1, 1, 1], 2.0 * c[0, 1, 0, 1]],
+            ]
+        )
+        if not np.all(np.isfinite(mandel)):
+            return float("nan")
+        return float(np.linalg.eigvalsh(0.5 * (mandel + mandel.T))[0]) / self.stiffness_scale
+
     @property
     def parameters(self) -> dict[str, object]:
         """The law's parameters by name (for reports and job files)."""

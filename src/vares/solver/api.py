@@ -26,7 +26,7 @@ from ..options import split_settings, takes_options
 from .alignment import align_warp, fibre_angle, initial_fibres, rotated
 from .continuation import solve_in_stages
 from .linear import get_solver, quiet_blas
-from .newton import Failure, NewtonContext, describe_cells
+from .newton import Failure, NewtonContext, describe_cells, exact_tangent_below
 from .options import SolveOptions
 from .result import IterationRecord, PatternResult
 from .start import Start, initial_guess
@@ -310,7 +310,21 @@ class _Run:
             # isotropic problems only: on the robustness suite's orthotropic deep cap and
             # steep saddle the absolute tangents led to other minima (docs/benchmarks.md)
             absolute_after_short_steps=not problem.orientation_matters,
+            exact_tangent_below=exact_tangent_below(_softness(problem)),
         )
+
+
+def _softness(problem: Problem) -> float:
+    """The softness of the problem's shear modes relative to its stiffness scale
+    (:func:`~vares.solver.newton.exact_tangent_below`): the law's
+    (:meth:`~vares.materials.Hyperelastic.softness`) where the yarn strains are locking-free
+    (``"smoothed"``, ``"paired"``); unknown (``nan``) cell by cell, where stiff yarns lock the
+    shear of linear triangles and the discrete problem is stiffer along it than the law (the
+    2,400-cell hemisphere at E/G = 1e6 from the default start: with the law's softness the
+    projected steps crept at relative residuals of 1e-5–1e-6 and the warp alignment failed)."""
+    if problem.yarn_strain == "element":
+        return float("nan")
+    return problem.material.softness(problem.fibres)
 
 
 def _held_node(free: np.ndarray) -> int:

@@ -34,17 +34,25 @@ __all__ = [
     "EXACT_TANGENT_BELOW",
     "METHODS",
     "ROUND_OFF_REGIME",
+    "SOFTNESS_REFERENCE",
     "AssembledDofs",
     "Failure",
     "NewtonContext",
     "absolute_hessians",
     "at_round_off",
     "describe_cells",
+    "exact_tangent_below",
     "newton",
 ]
 
-#: Relative residual below which globalised Newton returns from projected to exact tangents.
+#: Relative residual below which globalised Newton returns from projected to exact tangents,
+#: for a law whose softest small-strain stiffness is at least :data:`SOFTNESS_REFERENCE` of its
+#: stiffness scale (see :func:`exact_tangent_below`).
 EXACT_TANGENT_BELOW = 1e-2
+#: The softness (:meth:`~vares.materials.Hyperelastic.softness`) below which the switch to the
+#: exact tangent is moved down in proportion: isotropic laws (0.5–0.8) and coated fabrics
+#: (PES/PVC type II: 0.076; the robustness suite's orthotropic law 0.1) keep 1e-2.
+SOFTNESS_REFERENCE = 0.05
 #: Below this relative residual, full Newton steps that twice in a row fail to halve the residual
 #: mean it has reached the round-off floor of the mesh (ill-shaped cells make the floor higher
 #: than a tight tolerance): the iteration stops there (see :func:`at_round_off`).
@@ -58,6 +66,26 @@ SQUEEZED_PATTERN = (
 #: ``"full"``: plain Newton; ``"line-search"``: globalised; ``"damped"``: Levenberg–Marquardt;
 #: ``"bounded"``: exact Newton steps shortened to keep every cell admissible.
 METHODS = ("full", "line-search", "damped", "bounded")
+
+
+def exact_tangent_below(softness: float) -> float:
+    """The relative residual below which Newton takes the exact tangent, for a law of the
+    given softness: :data:`EXACT_TANGENT_BELOW`, times ``softness / SOFTNESS_REFERENCE`` when
+    that is smaller than 1.
+
+    The relative residual is measured against the stiffest stiffness (the yarns'), while how
+    far the pattern is from the minimum along its soft (shear) modes shows in the residual
+    scaled by the soft stiffness: the same distance gives a residual smaller by their ratio.
+    With yarns 10,000 times stiffer than the shear the exact tangent taken from a relative
+    residual of 1e-2 (from a kinematic net's pattern: at once) is a Newton step far from the
+    solution along the shear modes, which the line search cuts to 0.01–0.5 for dozens of
+    iterations (48 on the 2,400-cell hemisphere, 16 with the switch moved down; docs/locking.md).
+    The caller passes the softness of its discrete problem: the law's where the shear modes
+    are free (locking-free yarn strains), not where linear triangles lock them.
+    """
+    if not softness > 0:  # no small-strain stiffness to compare with: as for isotropic laws
+        return EXACT_TANGENT_BELOW
+    return EXACT_TANGENT_BELOW * min(1.0, softness / SOFTNESS_REFERENCE)
 
 
 def at_round_off(
@@ -136,6 +164,9 @@ class NewtonContext:
     #: negative ones set to zero (:func:`absolute_hessians`): a compressed cell's negative
     #: curvature then stiffens the step instead of leaving it free to fold that cell.
     absolute_after_short_steps: bool = False
+    #: Relative residual below which the line-search method takes the exact tangent
+    #: (:func:`exact_tangent_below`).
+    exact_tangent_below: float = EXACT_TANGENT_BELOW
 
     def __post_init__(self) -> None:
         #: the linear solver, reusing its factorisations where that is cheaper (inexact Newton)
@@ -223,7 +254,7 @@ def newton(
     - ``"full"``: plain Newton, full steps; a step that inverts a cell ends it.
     - ``"line-search"``: globalised Newton. The step is bounded so that every ``det J`` stays
       positive and backtracked until the energy decreases enough (Armijo). Far from the
-      solution (relative residual at or above :data:`EXACT_TANGENT_BELOW`) the tangent is the
+      solution (relative residual at or above ``ctx.exact_tangent_below``) the tangent is the
       quadrature-point-wise positive semi-definite projection of the exact one (projected
       Newton: always a descent direction); below it the exact tangent, so the final convergence
       is quadratic, with the projection as fallback whenever the exact step is no descent.
@@ -272,7 +303,7 @@ def newton(
             method == "line-search"
             and not ctx.turning  # the exact tangent first, whatever the residual
             and not converged
-            and residual >= EXACT_TANGENT_BELOW * ctx.force_scale
+            and residual >= ctx.exact_tangent_below * ctx.force_scale
         )
         hessians = problem.projected_hessians(evaluation) if projected else evaluation.hessians
         if projected and ctx.absolute_after_short_steps and step_length < 1.0:
