@@ -535,9 +535,15 @@ def test_the_warp_held_above_a_ratio_is_an_option_of_the_solve(tmp_path):
 
 def test_the_softness_of_a_law_is_its_softest_small_strain_stiffness_over_its_scale():
     """Isotropic laws: 2μ over E = 1/(1 + ν); orthotropic: 2 G12 over the larger yarn modulus;
-    the switch to the exact tangent moves down in proportion below SOFTNESS_REFERENCE only."""
+    a fabric's switch to the exact tangent moves down in proportion below SOFTNESS_REFERENCE
+    only; an isotropic problem's is ISOTROPIC_EXACT_TANGENT_BELOW."""
     from vares.materials import NeoHooke, StVenantKirchhoff
-    from vares.solver.newton import EXACT_TANGENT_BELOW, SOFTNESS_REFERENCE, exact_tangent_below
+    from vares.solver.newton import (
+        EXACT_TANGENT_BELOW,
+        ISOTROPIC_EXACT_TANGENT_BELOW,
+        SOFTNESS_REFERENCE,
+        exact_tangent_below,
+    )
 
     warp = Fibres.from_angles(30.0)
     assert StVenantKirchhoff(1000.0, 0.3).softness() == pytest.approx(1 / 1.3, rel=1e-12)
@@ -548,6 +554,7 @@ def test_the_softness_of_a_law_is_its_softest_small_strain_stiffness_over_its_sc
     assert exact_tangent_below(SOFTNESS_REFERENCE) == EXACT_TANGENT_BELOW
     assert exact_tangent_below(2e-4) == pytest.approx(EXACT_TANGENT_BELOW * 2e-4 / 0.05)
     assert exact_tangent_below(float("nan")) == EXACT_TANGENT_BELOW
+    assert exact_tangent_below(2e-4, isotropic=True) == ISOTROPIC_EXACT_TANGENT_BELOW
 
 
 def test_newton_stays_fast_with_stiff_locking_free_yarns():

@@ -132,6 +132,6 @@ def test_an_isotropic_problem_takes_the_exact_tangent_from_a_relative_residual_o
         result = vares.solve(mesh, vares.materials.NeoHooke(1000.0, 0.3))
     assert result.converged
     tangents = [record.tangent for record in result.history[1:]]
-    first_exact = tangents.index("exact")
+    first_exact = tangents.index("exact")  # history[first_exact]: where that step started
     assert 1e-2 <= result.history[first_exact].relative_residual < 5e-2
     assert result.iterations <= 4

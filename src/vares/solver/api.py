@@ -41,14 +41,6 @@ ENERGY_NOISE = 1e-13
 #: tangents take over (closer, its steps gain little that the turn does not undo; from
 #: further, the turning steps start off the valley floor; benchmarks/free_orientation.py).
 HELD_FIRST = 1e-2
-#: Where the energy does not depend on the yarns (an isotropic law without prestress) the exact
-#: tangent takes over from this relative residual on, not from 1e-2: measured on public scans
-#: with slivers (LSCM + ARAP race, benchmarks/race.py) the face of 51,712 triangles then takes 8
-#: Newton iterations instead of 11, the camel head 12 instead of 13, the lion 10 as before, the
-#: steep saddle of the robustness suite 4 instead of 5, every other isotropic row of
-#: benchmarks/robustness.py as before; fabrics kept theirs at 1e-2 (at 5e-2 four of their rows
-#: took 1–5 more, docs/benchmarks.md).
-ISOTROPIC_EXACT_TANGENT_BELOW = 5e-2
 
 
 @takes_options(SolveOptions)
@@ -318,10 +310,8 @@ class _Run:
             # isotropic problems only: on the robustness suite's orthotropic deep cap and
             # steep saddle the absolute tangents led to other minima (docs/benchmarks.md)
             absolute_after_short_steps=not problem.orientation_matters,
-            exact_tangent_below=(
-                ISOTROPIC_EXACT_TANGENT_BELOW
-                if not problem.orientation_matters
-                else exact_tangent_below(_softness(problem))
+            exact_tangent_below=exact_tangent_below(
+                _softness(problem), isotropic=not problem.orientation_matters
             ),
         )
 
