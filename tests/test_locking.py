@@ -528,9 +528,13 @@ def test_the_warp_held_above_a_ratio_is_an_option_of_the_solve(tmp_path):
     written = meshio.read(tmp_path / "p" / "pattern.obj").points[:, :2]
     np.testing.assert_allclose(written, held.coordinates, atol=1e-6)
     with pytest.raises(OptionsError, match="yarn_continuation"):
-        vares.solve(mesh, stiff, yarn_align_up_to=1e4, **settings)
-    refused = run("pattern", source, "-o", tmp_path / "q", *flags, "--yarn-align-up-to", "1e4")
+        vares.solve(mesh, stiff, yarn_continuation="none", yarn_align_up_to=1e4, **settings)
+    refused = run("pattern", source, "-o", tmp_path / "q", *flags, "--yarn-continuation", "none",
+                  "--yarn-align-up-to", "1e4")  # fmt: skip
     assert refused.exit_code == 2 and "--yarn-align-up-to" in error_line(refused)
+    # the default (auto) takes the one stage at 1e4 for E/G 1e6 with paired yarn stretches
+    auto = vares.solve(mesh, stiff, yarn_align_up_to=1e4, **settings)
+    np.testing.assert_allclose(auto.material_coordinates, held.coordinates, atol=1e-12)
 
 
 def test_the_softness_of_a_law_is_its_softest_small_strain_stiffness_over_its_scale():
@@ -585,3 +589,29 @@ def test_newton_stays_fast_with_stiff_locking_free_yarns():
         )
     assert np.abs(tables[0] - tables[1]).max() < 0.05
     assert np.abs(tables[0] - NET).max() < 2.0
+
+
+def test_the_default_continuation_takes_one_stage_for_stiff_locking_free_yarns():
+    """``yarn_continuation = "auto"`` (the default): one stage at 1e4 for laws of a higher
+    yarn-to-shear ratio with smoothed or paired yarn stretches; none with cell-wise ones, for
+    softer or isotropic laws, or with ``"none"``; given ratios as they are."""
+    from vares.materials import StVenantKirchhoff
+    from vares.solver import SolveOptions
+    from vares.solver.continuation import continuation_ratios
+
+    def ratios(law, **settings):
+        return continuation_ratios(law, SolveOptions(**settings))
+
+    woven = {r: OrthotropicStVenantKirchhoff(E1=r, E2=r, G12=1.0, nu12=0.0) for r in (1e4, 1e6)}
+    assert SolveOptions().yarn_continuation == "auto"
+    assert ratios(woven[1e6], yarn_strain="paired") == (1e4,)
+    assert ratios(woven[1e6], yarn_strain="smoothed") == (1e4,)
+    assert ratios(woven[1e6], yarn_strain="element") == ()
+    assert ratios(woven[1e4], yarn_strain="paired") == ()
+    assert ratios(StVenantKirchhoff(E=1.0, nu=0.3), yarn_strain="paired") == ()
+    assert ratios(woven[1e6], yarn_strain="paired", yarn_continuation="none") == ()
+    assert ratios(woven[1e6], yarn_continuation=(1e2, 1e3)) == (1e2, 1e3)
+    from vares.options import OptionsError
+
+    with pytest.raises(OptionsError, match="yarn_continuation"):
+        SolveOptions(yarn_continuation="some")

@@ -74,7 +74,8 @@ class Spec:
     """What an option accepts and how it is presented.
 
     ``kind`` is one of :data:`KINDS`; ``choices`` the admissible strings (of a ``str`` or each
-    item of ``strings``); ``minimum`` an inclusive lower bound and ``positive`` a strict one (> 0);
+    item of ``strings``; of ``floats``, the names it takes beside a list, e.g. ``"auto"``);
+    ``minimum`` an inclusive lower bound and ``positive`` a strict one (> 0);
     ``optional`` admits ``None``. ``section`` is the job-file table the option lives in,
     ``flags`` its command-line names (``None``: ``--name-with-dashes``; ``()``: not a flag).
     """
@@ -169,7 +170,9 @@ class Spec:
             raise self._refuse(key, value)
         return tuple(self._check_path(key, v) for v in value)
 
-    def _check_floats(self, key: str, value: Any) -> tuple[float, ...]:
+    def _check_floats(self, key: str, value: Any) -> tuple[float, ...] | str:
+        if isinstance(value, str) and self.choices:
+            return self._choice(key, value)
         if isinstance(value, str) or not _is_sequence(value):
             raise self._refuse(key, value)
         plain = Spec("float", "", self.section)
@@ -180,7 +183,7 @@ class Spec:
 
     def _check_vector(self, key: str, value: Any) -> tuple[float, float, float]:
         try:
-            vector = self._check_floats(key, value)
+            vector = Spec("floats", "", self.section).check(key, value)
         except OptionsError:
             raise self._refuse(key, value) from None
         if len(vector) != 3 or not any(vector):
@@ -362,7 +365,9 @@ def takes_options(*classes: type[Options]) -> Callable[[Callable], Callable]:
                         name,
                         inspect.Parameter.KEYWORD_ONLY,
                         default=defaults[name],
-                        annotation=_ANNOTATIONS[spec.kind] + (" | None" if spec.optional else ""),
+                        annotation=_ANNOTATIONS[spec.kind]
+                        + (" | str" if spec.kind == "floats" and spec.choices else "")
+                        + (" | None" if spec.optional else ""),
                     )
                 )
         func.__signature__ = signature.replace(parameters=own + added)

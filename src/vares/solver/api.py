@@ -24,7 +24,7 @@ from ..mechanics.problem import Problem
 from ..mechanics.rigid import rigid_modes
 from ..options import split_settings, takes_options
 from .alignment import align_warp, fibre_angle, initial_fibres, rotated
-from .continuation import solve_in_stages
+from .continuation import continuation_ratios, solve_in_stages
 from .linear import get_solver, quiet_blas
 from .newton import Failure, NewtonContext, describe_cells, exact_tangent_below
 from .options import SolveOptions
@@ -94,14 +94,15 @@ def solve(
     (options,) = split_settings(settings, [options or SolveOptions()])
     with quiet_blas():
         warm_up = _load_kernels(mesh, material, options.linear_solver)
-        if options.yarn_continuation:  # the law's yarns reached through softer ones
+        ratios = continuation_ratios(material, options)
+        if ratios:  # the law's yarns reached through softer ones
             result, _ = solve_in_stages(
                 lambda law, stage, start: _solve(
                     mesh, law, thickness, prestress, stage, callback, start
                 ),
                 mesh,
                 material,
-                options,
+                options.replace(yarn_continuation=ratios),
                 given,
             )
         else:

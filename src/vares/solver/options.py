@@ -71,13 +71,16 @@ class SolveOptions(Options):
         section="fibres",
         minimum=0,
     )
-    yarn_continuation: tuple[float, ...] = option(
-        (),
+    yarn_continuation: tuple[float, ...] | str = option(
+        "auto",
         "floats",
         "Stiff fibre laws: yarn-to-shear ratios E/G 'r1,r2,…' (ascending, below the law's) "
         "solved first with the law's yarns softened to each, every stage from the last "
-        "pattern, the law itself last; e.g. 1e2,1e3,1e4,1e5 for E/G = 1e6 (docs/locking.md).",
+        "pattern, the law itself last; e.g. 1e2,1e3,1e4,1e5 for E/G = 1e6; auto: one stage "
+        "at 1e4 for laws stiffer than that with smoothed or paired yarn stretches, none else; "
+        "none: the law directly (docs/locking.md).",
         section="fibres",
+        choices=("auto", "none"),
     )
     yarn_align_up_to: float | None = option(
         None,
@@ -148,11 +151,12 @@ class SolveOptions(Options):
 
     def check(self) -> None:
         ratios = self.yarn_continuation
+        ratios = () if isinstance(ratios, str) else ratios
         if any(r <= 0.0 for r in ratios) or any(b <= a for a, b in pairwise(ratios)):
             raise OptionsError(
                 "yarn_continuation", f"must be ascending positive ratios; got {list(ratios)}"
             )
-        if self.yarn_align_up_to is not None and not ratios:
+        if self.yarn_align_up_to is not None and self.yarn_continuation in ((), "none"):
             raise OptionsError(
                 "yarn_align_up_to", "applies to the stages of a yarn_continuation; none is given"
             )

@@ -177,7 +177,8 @@ def _parse(name: str, spec: Spec, text: str) -> Any:
             raise InputError(f"{flag}: expected three numbers 'x,y,z'; got {text!r}")
         return values
     if spec.kind == "floats":
-        return numbers(flag, text)
+        named = [c for c in spec.choices or () if c.lower() == text.strip().lower()]
+        return named[0] if named else numbers(flag, text)
     if spec.kind in ("strings", "paths"):
         return tuple(v.strip() for v in text.split(",") if v.strip())
     return text
