@@ -532,6 +532,8 @@ def test_the_warp_held_above_a_ratio_is_an_option_of_the_solve(tmp_path):
     refused = run("pattern", source, "-o", tmp_path / "q", *flags, "--yarn-continuation", "none",
                   "--yarn-align-up-to", "1e4")  # fmt: skip
     assert refused.exit_code == 2 and "--yarn-align-up-to" in error_line(refused)
+    unknown = run("pattern", source, "-o", tmp_path / "r", *flags, "--yarn-continuation", "soon")
+    assert unknown.exit_code == 2 and "one of auto, none" in error_line(unknown)
     # the default (auto) takes the one stage at 1e4 for E/G 1e6 with paired yarn stretches
     auto = vares.solve(mesh, stiff, yarn_align_up_to=1e4, **settings)
     np.testing.assert_allclose(auto.material_coordinates, held.coordinates, atol=1e-12)

@@ -178,7 +178,17 @@ def _parse(name: str, spec: Spec, text: str) -> Any:
         return values
     if spec.kind == "floats":
         named = [c for c in spec.choices or () if c.lower() == text.strip().lower()]
-        return named[0] if named else numbers(flag, text)
+        if named:
+            return named[0]
+        try:
+            return numbers(flag, text)
+        except InputError:
+            if not spec.choices:
+                raise
+            raise InputError(
+                f"{flag}: expected numbers 'a,b,…' or one of {', '.join(spec.choices)}; "
+                f"got {text!r}"
+            ) from None
     if spec.kind in ("strings", "paths"):
         return tuple(v.strip() for v in text.split(",") if v.strip())
     return text
