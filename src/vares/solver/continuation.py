@@ -85,11 +85,10 @@ def checked_ratios(material: Hyperelastic, ratios: Sequence[float]) -> tuple[flo
 
 
 def continuation_ratios(material: Hyperelastic, options: SolveOptions) -> tuple[float, ...]:
-    """The stages ``options.yarn_continuation`` asks for: its ratios (``"none"``: none), or with
-    ``"auto"`` one
-    stage at :data:`AUTO_RATIO` for a law of ``(I4, I6, I8)`` stiffer than that whose yarn
-    stretches are smoothed or paired (cell by cell the stiff yarns lock the shear of linear
-    triangles, and the stage would reach another pattern), none else."""
+    """The stages ``options.yarn_continuation`` asks for: its ratios (``"none"``: none), or
+    with ``"auto"`` one stage at :data:`AUTO_RATIO` for a law of ``(I4, I6, I8)`` stiffer than
+    that whose yarn stretches are smoothed or paired, none else (cell by cell the stiff yarns
+    lock the shear of linear triangles, and the stage would reach another pattern)."""
     if options.yarn_continuation == "none":
         return ()
     if options.yarn_continuation != "auto":
