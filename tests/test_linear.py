@@ -99,6 +99,16 @@ def test_quiet_blas_limits_openblas_to_one_thread_and_restores_it():
         pytest.skip("NumPy and SciPy are not linked to OpenBLAS here")
     with linear.quiet_blas():
         assert openblas_threads() == [1] * len(before)
+        with linear.quiet_blas():  # nested: the outer context gives the threads back
+            assert openblas_threads() == [1] * len(before)
+        assert openblas_threads() == [1] * len(before)
+    assert openblas_threads() == before
+    # the erection and the structure solve run quietly too (their Newton iterations' callbacks)
+    seen = []
+    mesh = examples.cylinder160(n_around=8, n_along=4)
+    result = vares.solve(mesh, vares.materials.NeoHooke(E=1000.0, nu=0.3), prestress=(1.0, 1.0))
+    vares.erect(result, callback=lambda record: seen.append(openblas_threads()))
+    assert seen and all(threads == [1] * len(before) for threads in seen)
     assert openblas_threads() == before
 
 

@@ -62,7 +62,7 @@ from ..mechanics.assembly import Assembler
 from ..mechanics.contact import SlidingNodes, turned_over
 from ..mechanics.erection import ErectionProblem, membrane_block
 from ..mechanics.forward import deformation_gradients
-from ..solver.linear import SingularMatrixError, get_solver
+from ..solver.linear import SingularMatrixError, get_solver, quiet_blas
 from .blank_start import kinematic_start
 from .blank_trim import trim_blank
 from .erection_fields import membrane_forces
@@ -173,6 +173,7 @@ class BlankDrapeResult:
         }
 
 
+@quiet_blas()
 def drape_blank(
     mould: SurfaceMesh,
     blank: Blank,

@@ -25,7 +25,7 @@ from ..materials import Hyperelastic
 from ..mechanics.erection import Cables, ErectionProblem
 from ..mechanics.wrinkling import WrinklingError
 from ..options import split_settings, takes_options
-from ..solver.linear import get_solver
+from ..solver.linear import get_solver, quiet_blas
 from ..solver.newton import NewtonContext, describe_cells
 from ..solver.options import SolveOptions
 from ..solver.result import IterationRecord, PatternResult, StepRecord
@@ -222,6 +222,7 @@ class ErectionResult:
 
 
 @takes_options(ErectionOptions)
+@quiet_blas()
 def erect(
     source: Any,
     material: Hyperelastic | None = None,

@@ -22,6 +22,8 @@ fastest first (measured in docs/benchmarks.md):
 from __future__ import annotations
 
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Protocol
 
@@ -69,14 +71,33 @@ class LinearSolver(Protocol):
     def solve(self, rhs: np.ndarray) -> np.ndarray: ...
 
 
-def quiet_blas():
-    """A context in which OpenBLAS (NumPy's and SciPy's) runs on one thread; MKL, which runs
-    PARDISO, keeps its threads. vares' own BLAS calls are on vectors; left multi-threaded,
-    OpenBLAS's worker keeps spinning after each call and takes a core from PARDISO, which then
-    factorises at single-thread speed (docs/benchmarks.md)."""
-    from threadpoolctl import ThreadpoolController
+_QUIET_LOCK = threading.Lock()
+_quiet: dict = {"depth": 0, "limiter": None}
 
-    return ThreadpoolController().select(internal_api="openblas").limit(limits=1)
+
+@contextmanager
+def quiet_blas() -> Iterator[None]:
+    """A context (or a decorator: ``@quiet_blas()``) in which OpenBLAS (NumPy's and SciPy's)
+    runs on one thread; MKL, which runs PARDISO, keeps its threads. vares' own BLAS calls are
+    on vectors; left multi-threaded, OpenBLAS's worker keeps spinning after each call and takes
+    a core from PARDISO, which then factorises at single-thread speed, and a vector norm beside
+    PARDISO's threads takes milliseconds (docs/benchmarks.md). Nested contexts cost nothing:
+    only the outermost limits the threads (about 2 ms) and gives them back."""
+    with _QUIET_LOCK:
+        if _quiet["depth"] == 0:
+            from threadpoolctl import ThreadpoolController
+
+            controller = ThreadpoolController().select(internal_api="openblas")
+            _quiet["limiter"] = controller.limit(limits=1)
+        _quiet["depth"] += 1
+    try:
+        yield
+    finally:
+        with _QUIET_LOCK:
+            _quiet["depth"] -= 1
+            if _quiet["depth"] == 0:
+                _quiet["limiter"].restore_original_limits()
+                _quiet["limiter"] = None
 
 
 def _finite(x: np.ndarray) -> np.ndarray:

@@ -33,7 +33,7 @@ from ..geometry.injectivity import pattern_area_misfit, pattern_overlap
 from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
 from ..solver import IterationRecord, PatternResult, SolveOptions, solve
-from ..solver.linear import get_solver
+from ..solver.linear import get_solver, quiet_blas
 from ..solver.newton import AssembledDofs, Failure, NewtonContext, newton
 from .coupled import KKT, CoupledProblem, SeamMatching
 from .options import StructureOptions
@@ -101,6 +101,7 @@ class StructureResult:
 
 
 @takes_options(SolveOptions, StructureOptions)
+@quiet_blas()
 def solve_structure(
     panels: Sequence[Panel],
     material: Hyperelastic,
