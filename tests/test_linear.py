@@ -3,6 +3,7 @@ threads."""
 
 from __future__ import annotations
 
+import gc
 import itertools
 
 import numpy as np
@@ -246,6 +247,36 @@ def test_two_solvers_factorise_and_solve_in_turn(name):
         for solver, matrix in zip(solvers, matrices, strict=True):
             rhs = rng.normal(size=matrix.shape[0])
             np.testing.assert_allclose(matrix @ solver.solve(rhs), rhs, atol=1e-10)
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")
+def test_a_pardiso_solver_with_its_own_factors_keeps_them_while_others_factorise(monkeypatch):
+    """``own_factors``: a handle of its own, so solving between another solver's factorisations
+    does not factorise again (the shared handle's solvers would); its memory is given back."""
+    rng = np.random.default_rng(2)
+    matrices = []
+    for size in (30, 40):
+        a = sp.random(size, size, density=0.2, random_state=rng)
+        matrices.append((a @ a.T + size * sp.identity(size)).tocsr())
+    numeric = []
+    original = linear.PardisoSolver._numeric
+    monkeypatch.setattr(
+        linear.PardisoSolver, "_numeric", lambda self: (numeric.append(self), original(self))
+    )
+    own, shared = get_solver("pardiso", own_factors=True), get_solver("pardiso")
+    assert own._solver is not shared._solver
+    own.factorize(matrices[0])
+    for _ in range(3):
+        shared.factorize(matrices[1])
+        rhs = rng.normal(size=30)
+        np.testing.assert_allclose(matrices[0] @ own.solve(rhs), rhs, atol=1e-10)
+    assert numeric.count(own) == 1 and numeric.count(shared) == 3
+    release = own._state.release  # the handle's memory given back with the solver
+    assert release.alive
+    numeric.clear()
+    del own
+    gc.collect()
+    assert not release.alive
 
 
 @pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")

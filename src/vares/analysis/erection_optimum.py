@@ -213,7 +213,9 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
                 nodes = layout.num_variables // 2
                 coarse = min(1.0, DAMPING_NODES / nodes)
                 mu = INITIAL_DAMPING * coarse * _norm_squared(model.operator())
-                preconditioner = stiffness_preconditioner(patterns, material, thickness)
+                preconditioner = stiffness_preconditioner(
+                    patterns, material, thickness, solver.linear_solver
+                )
 
             def strain_of(v, at=current):
                 return edge_strain(at, v, edges, layout)

@@ -394,7 +394,10 @@ def shape_by_x_of(weights: np.ndarray, normals: np.ndarray, n_nodes: int) -> sp.
 
 
 def stiffness_preconditioner(
-    patterns: list[Pattern], material: Hyperelastic, thickness: float
+    patterns: list[Pattern],
+    material: Hyperelastic,
+    thickness: float,
+    linear_solver: str | None = None,
 ) -> spla.LinearOperator:
     """``(H + σ I)⁻¹`` ``(N, N)`` over all patterns' coordinates: ``H`` the patterning energy's
     Hessian (without prestress, made positive semi-definite) of each pattern on its design
@@ -403,7 +406,8 @@ def stiffness_preconditioner(
     A right preconditioner of LSQR for ``J``: a change of the patterns weighted by the inverse
     of their stiffness is one the erected forces follow evenly, and LSQR needs about a third of
     the iterations for the same step (docs/erection.md). The patterns move by a few per cent
-    while they are optimised: the factors of the starting patterns serve every step."""
+    while they are optimised: the factors of the starting patterns serve every step. Factorised
+    by ``linear_solver`` (None: the fastest installed), with factors of its own."""
     blocks = []
     for pattern in patterns:
         problem = Problem(pattern.mesh, material, thickness, fibres=pattern.fibres)
@@ -413,8 +417,8 @@ def stiffness_preconditioner(
         blocks.append(assembler.matrix(evaluation.hessians))
     H = sp.block_diag(blocks, format="csr")
     shifted = (H + PRECONDITIONER_SHIFT * H.diagonal().mean() * sp.eye(H.shape[0])).tocsr()
-    # SuperLU, not PARDISO: PARDISO's one handle holds the erection tangent's factors
-    solver = get_solver("scipy-superlu")
+    # factors of its own: the erection tangent's are made and solved with between its solves
+    solver = get_solver(linear_solver, own_factors=True)
     solver.factorize(shifted)
     return spla.LinearOperator(H.shape, matvec=solver.solve, rmatvec=solver.solve, dtype=float)
 

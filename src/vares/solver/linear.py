@@ -22,9 +22,11 @@ fastest first (measured in docs/benchmarks.md):
 from __future__ import annotations
 
 import threading
+import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Protocol
 
 import numpy as np
@@ -193,8 +195,8 @@ class PardisoSolver:
     reuse_iterations = 3
     cautious_reuse = True
 
-    def __init__(self) -> None:
-        self._state = _pardiso_state()
+    def __init__(self, own_factors: bool = False) -> None:
+        self._state = _own_pardiso_state(self) if own_factors else _pardiso_state()
         self._solver = self._state.handle
         self._matrix = None
         self._upper = None
@@ -291,15 +293,27 @@ _PARDISO_STATE = PardisoState()
 def _pardiso_state() -> PardisoState:
     state = _PARDISO_STATE
     if state.handle is None:
-        _point_pypardiso_at_mkl()
-        import pypardiso
-
-        handle = pypardiso.PyPardisoSolver(mtype=-2)
-        handle.set_statistical_info_off()
-        for index, value in _PARDISO_SETTINGS.items():
-            handle.iparm[index - 1] = value
-        state.handle = handle
+        state.handle = _pardiso_handle()
     return state
+
+
+def _own_pardiso_state(owner: PardisoSolver) -> SimpleNamespace:
+    """A PARDISO handle for ``owner`` alone (its factors stay while the thread's handle
+    factorises other matrices), its memory given back to MKL when ``owner`` is collected."""
+    handle = _pardiso_handle()
+    release = weakref.finalize(owner, handle.free_memory, everything=True)
+    return SimpleNamespace(handle=handle, analysed=None, factors=None, release=release)
+
+
+def _pardiso_handle():
+    _point_pypardiso_at_mkl()
+    import pypardiso
+
+    handle = pypardiso.PyPardisoSolver(mtype=-2)
+    handle.set_statistical_info_off()
+    for index, value in _PARDISO_SETTINGS.items():
+        handle.iparm[index - 1] = value
+    return handle
 
 
 def forget_pardiso_analysis() -> None:
@@ -440,8 +454,10 @@ def available_solvers() -> list[str]:
     return [name for name in _SOLVERS if name not in _MODULES or _importable(_MODULES[name])]
 
 
-def get_solver(name: str | None = None) -> LinearSolver:
-    """A new solver by name; ``None`` picks the fastest available one."""
+def get_solver(name: str | None = None, own_factors: bool = False) -> LinearSolver:
+    """A new solver by name; ``None`` picks the fastest available one. ``own_factors``: its
+    factors are its own while other solvers factorise (PARDISO's solvers of one thread share a
+    handle, and one factorises again after another did; this one has a handle of its own)."""
     available = available_solvers()
     if name is None:
         name = available[0]
@@ -452,6 +468,8 @@ def get_solver(name: str | None = None) -> LinearSolver:
             f"linear solver {name!r} is not installed (pip install 'vares[{name}]'); "
             f"available: {', '.join(available)}"
         )
+    if own_factors and name == "pardiso":
+        return PardisoSolver(own_factors=True)
     return _SOLVERS[name]()
 
 
