@@ -237,10 +237,14 @@ class PardisoSolver:
         state = self._state
         size = matrix.shape[0]
         if self._upper is None or not _same_pattern(self._upper[0], _pattern(matrix)):
-            index, indptr, indices = _upper_triangle_map(matrix)
-            self._upper = (_pattern(matrix), index, indptr, indices)
-            self._ia = (indptr + 1).astype(np.int32)
-            self._ja = (indices + 1).astype(np.int32)
+            # the map of the thread's last pattern is kept: every erection of a mesh (and each
+            # state an optimiser linearises) assembles a new matrix of the same pattern
+            known = state.upper
+            if known is None or not _same_pattern(known[0], _pattern(matrix)):
+                index, indptr, indices = _upper_triangle_map(matrix)
+                ia, ja = (indptr + 1).astype(np.int32), (indices + 1).astype(np.int32)
+                known = state.upper = (_pattern(matrix), index, indptr, indices, ia, ja)
+            self._upper, self._ia, self._ja = known[:4], known[4], known[5]
         _, index, indptr, indices = self._upper
         # PARDISO needs every diagonal entry stored, even a zero one (a bordered constraint):
         # the map's index -1 is such an added zero
@@ -280,11 +284,13 @@ class PardisoState(threading.local):
     """A thread's PARDISO handle (made when the thread first solves; MKL itself is loaded
     once per process), the sparsity pattern it has analysed (see :func:`_pattern`) and the
     solver whose numeric factors it holds (a solver whose matrix was factorised by another
-    since factorises it again before it solves)."""
+    since factorises it again before it solves), and the upper-triangle map of the last
+    sparsity pattern factorised (:func:`_upper_triangle_map`)."""
 
     handle = None
     analysed: tuple | None = None
     factors: PardisoSolver | None = None
+    upper: tuple | None = None
 
 
 _PARDISO_STATE = PardisoState()
@@ -302,7 +308,7 @@ def _own_pardiso_state(owner: PardisoSolver) -> SimpleNamespace:
     factorises other matrices), its memory given back to MKL when ``owner`` is collected."""
     handle = _pardiso_handle()
     release = weakref.finalize(owner, handle.free_memory, everything=True)
-    return SimpleNamespace(handle=handle, analysed=None, factors=None, release=release)
+    return SimpleNamespace(handle=handle, analysed=None, factors=None, upper=None, release=release)
 
 
 def _pardiso_handle():
