@@ -250,6 +250,32 @@ def test_two_solvers_factorise_and_solve_in_turn(name):
 
 
 @pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")
+def test_pardiso_maps_a_sparsity_pattern_to_its_upper_triangle_once(monkeypatch):
+    """New solvers of the thread factorising matrices of one pattern (an erection's, then an
+    optimiser's states) reuse the upper-triangle map of the last pattern; another pattern is
+    mapped afresh, and every solve is right."""
+    calls = []
+    original = linear._upper_triangle_map
+    monkeypatch.setattr(
+        linear, "_upper_triangle_map", lambda matrix: (calls.append(1), original(matrix))[1]
+    )
+    monkeypatch.setattr(linear._PARDISO_STATE, "upper", None)
+    rng = np.random.default_rng(3)
+    a = sp.random(40, 40, density=0.2, random_state=rng)
+    first = (a @ a.T + 40 * sp.identity(40)).tocsr()
+    same = first.copy()
+    same.data = same.data * 2.0
+    b = sp.random(40, 40, density=0.3, random_state=rng)
+    other = (b @ b.T + 40 * sp.identity(40)).tocsr()
+    for matrix, mapped in ((first, 1), (same, 1), (other, 2)):
+        solver = get_solver("pardiso")
+        solver.factorize(matrix)
+        rhs = rng.normal(size=40)
+        np.testing.assert_allclose(matrix @ solver.solve(rhs), rhs, atol=1e-10)
+        assert len(calls) == mapped
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")
 def test_a_pardiso_solver_with_its_own_factors_keeps_them_while_others_factorise(monkeypatch):
     """``own_factors``: a handle of its own, so solving between another solver's factorisations
     does not factorise again (the shared handle's solvers would); its memory is given back."""
