@@ -179,7 +179,10 @@ class PardisoSolver:
     The symbolic analysis (phase 11) is redone only when the sparsity pattern changes; each
     factorisation is the numeric phase 22 alone. The instances of one thread share one PARDISO
     handle (its analysis and factors, :class:`PardisoState`); each thread has its own, so solves
-    in several threads at once (a Dask worker's threads) do not disturb one another.
+    in several threads at once (a Dask worker's threads) do not disturb one another. With
+    ``own_factors`` a solver has a handle of its own, given back to MKL when the solver is
+    collected: its factors stay while the thread's other solvers factorise (a preconditioner
+    beside a Newton iteration's tangent).
 
     Settings (chosen by measurement, docs/benchmarks.md): minimum-degree ordering below
     :data:`NESTED_DISSECTION_ABOVE` unknowns (its analysis is 3× faster and its fill no larger
