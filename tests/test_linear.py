@@ -15,6 +15,7 @@ from vares import examples
 from vares.materials import OrthotropicStVenantKirchhoff
 from vares.solver import linear
 from vares.solver.linear import SingularMatrixError, available_solvers, get_solver
+from vares.structures import matching
 
 ORTHO = OrthotropicStVenantKirchhoff(800.0, 640.0, 40.0, 0.4)
 
@@ -86,7 +87,7 @@ def test_every_solver_solves_a_bordered_indefinite_system(name):
         assert np.linalg.norm(matrix @ x - rhs) <= 1e-10 * np.linalg.norm(rhs)
 
 
-def test_quiet_blas_limits_openblas_to_one_thread_and_restores_it():
+def test_quiet_blas_limits_openblas_to_one_thread_and_restores_it(monkeypatch):
     from threadpoolctl import ThreadpoolController
 
     def openblas_threads():
@@ -109,6 +110,21 @@ def test_quiet_blas_limits_openblas_to_one_thread_and_restores_it():
     mesh = examples.cylinder160(n_around=8, n_along=4)
     result = vares.solve(mesh, vares.materials.NeoHooke(E=1000.0, nu=0.3), prestress=(1.0, 1.0))
     vares.erect(result, callback=lambda record: seen.append(openblas_threads()))
+    assert seen and all(threads == [1] * len(before) for threads in seen)
+    assert openblas_threads() == before
+    # the seam matching's own Newton iterations, between the panels' solves
+    seen.clear()
+    original = matching.newton
+    monkeypatch.setattr(
+        matching, "newton", lambda *a, **k: (seen.append(openblas_threads()), original(*a, **k))[1]
+    )
+    apart = (mesh.points[mesh.cells["triangle"]].mean(axis=1)[:, 0] > 0.3).astype(int)
+    vares.solve_structure(
+        vares.split_panels(mesh, apart),
+        vares.materials.NeoHooke(E=1000.0, nu=0.3),
+        prestress=(1.0, 0.5),
+        match_seams=True,
+    )
     assert seen and all(threads == [1] * len(before) for threads in seen)
     assert openblas_threads() == before
 

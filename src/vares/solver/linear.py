@@ -26,7 +26,6 @@ import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Protocol
 
 import numpy as np
@@ -283,17 +282,22 @@ class PardisoSolver:
         return _finite(self._phase(33, np.ascontiguousarray(rhs, dtype=float)))
 
 
-class PardisoState(threading.local):
-    """A thread's PARDISO handle (made when the thread first solves; MKL itself is loaded
-    once per process), the sparsity pattern it has analysed (see :func:`_pattern`) and the
-    solver whose numeric factors it holds (a solver whose matrix was factorised by another
-    since factorises it again before it solves), and the upper-triangle map of the last
-    sparsity pattern factorised (:func:`_upper_triangle_map`)."""
+class HandleState:
+    """A PARDISO handle (made when first needed; MKL itself is loaded once per process), the
+    sparsity pattern it has analysed (see :func:`_pattern`), the solver whose numeric factors
+    it holds (a solver whose matrix was factorised by another since factorises it again before
+    it solves), the upper-triangle map of the last sparsity pattern factorised
+    (:func:`_upper_triangle_map`), and for a solver's own handle, what gives its memory back."""
 
     handle = None
     analysed: tuple | None = None
     factors: PardisoSolver | None = None
     upper: tuple | None = None
+    release: weakref.finalize | None = None
+
+
+class PardisoState(HandleState, threading.local):
+    """A thread's :class:`HandleState`, shared by the thread's solvers."""
 
 
 _PARDISO_STATE = PardisoState()
@@ -306,12 +310,13 @@ def _pardiso_state() -> PardisoState:
     return state
 
 
-def _own_pardiso_state(owner: PardisoSolver) -> SimpleNamespace:
+def _own_pardiso_state(owner: PardisoSolver) -> HandleState:
     """A PARDISO handle for ``owner`` alone (its factors stay while the thread's handle
     factorises other matrices), its memory given back to MKL when ``owner`` is collected."""
-    handle = _pardiso_handle()
-    release = weakref.finalize(owner, handle.free_memory, everything=True)
-    return SimpleNamespace(handle=handle, analysed=None, factors=None, upper=None, release=release)
+    state = HandleState()
+    state.handle = _pardiso_handle()
+    state.release = weakref.finalize(owner, state.handle.free_memory, everything=True)
+    return state
 
 
 def _pardiso_handle():
@@ -385,6 +390,8 @@ def _pattern(matrix: sp.csr_matrix) -> tuple:
 
 
 def _same_pattern(a: tuple, b: tuple) -> bool:
+    if a[0] == b[0] and a[1] is b[1] and a[2] is b[2]:  # one assembler's arrays: no comparison
+        return True
     return (
         a[0] == b[0]
         and a[2].size == b[2].size
