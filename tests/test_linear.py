@@ -347,3 +347,65 @@ def test_pardiso_solves_in_two_threads_at_once_as_each_alone():
         assert len(together[i]) == 3
         for coordinates in together[i]:
             np.testing.assert_array_equal(coordinates, alone[i])
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")
+def test_pardiso_lu_solves_unsymmetric_systems_and_falls_back_where_it_is_inaccurate(monkeypatch):
+    """The unsymmetric factoriser: PARDISO's LU on a diagonally dominant unsymmetric matrix
+    (as Tutte's mean-value Laplacian) to round-off, two right-hand sides at once; a solve it
+    gets wrong is redone by SuperLU with partial pivoting; its handle's memory is given back."""
+    rng = np.random.default_rng(3)
+    n = 60
+    off = sp.random(n, n, density=0.1, random_state=rng, format="csr")
+    matrix = (sp.diags(np.asarray(abs(off).sum(axis=1)).ravel() + 1.0) - off).tocsr()
+    assert abs(matrix - matrix.T).max() > 0.1  # really unsymmetric
+    rhs = rng.normal(size=(n, 2))
+    factorize = linear.unsymmetric_factorizer("pardiso")
+    np.testing.assert_allclose(matrix @ factorize(matrix)(rhs), rhs, atol=1e-12)
+    assert linear.unsymmetric_factorizer("scipy-superlu") is None  # the caller keeps SuperLU
+    lu = linear.PardisoLU(matrix)
+    release = lu._release
+    del lu
+    gc.collect()
+    assert not release.alive
+    # a handle whose solve is off: the check finds it and SuperLU answers instead
+    lu = linear.PardisoLU(matrix)
+    monkeypatch.setattr(lu._handle, "solve", lambda a, b: b * 0.5)
+    np.testing.assert_allclose(matrix @ lu.solve(rhs), rhs, atol=1e-12)
+    assert lu._fallback is not None and not lu._release.alive
+    np.testing.assert_allclose(matrix @ lu.solve(rhs[:, 0]), rhs[:, 0], atol=1e-12)
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")
+def test_tutte_by_pardiso_lu_is_tutte_by_superlu(monkeypatch):
+    """The solve's Tutte start is factorised by PARDISO's LU where the solve runs PARDISO, by
+    SuperLU where it runs SuperLU, and it is the same embedding either way."""
+    import warnings
+
+    from vares.geometry import flatten
+
+    mesh = examples.hypar(size=2.0, rise=2.5, n=20)  # the steep saddle: LSCM folds it
+    by_superlu = flatten.tutte(mesh)
+    by_pardiso = flatten.tutte(mesh, factorize=linear.unsymmetric_factorizer("pardiso"))
+    np.testing.assert_allclose(by_pardiso, by_superlu, atol=1e-12 * np.abs(by_superlu).max())
+    made = []
+    original = linear.PardisoLU.__init__
+
+    def counted(self, matrix):
+        made.append(matrix.shape)
+        original(self, matrix)
+
+    monkeypatch.setattr(linear.PardisoLU, "__init__", counted)
+    material = vares.materials.NeoHooke(1000.0, 0.3)
+    results = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the conformal map folds: started from Tutte's
+        for name in ("scipy-superlu", "pardiso"):
+            results[name] = vares.solve(mesh, material, linear_solver=name)
+            assert results[name].initial_guess == "tutte"
+            assert len(made) == (name == "pardiso")
+    np.testing.assert_allclose(
+        results["pardiso"].material_coordinates,
+        results["scipy-superlu"].material_coordinates,
+        atol=1e-9 * np.abs(by_superlu).max(),
+    )

@@ -271,7 +271,11 @@ def _projected_area_ratios(mesh: SurfaceMesh, plane: ProjectionPlane):
     return np.concatenate(ratios), np.concatenate(areas)
 
 
-def tutte(mesh: SurfaceMesh, conformal: np.ndarray | None = None) -> np.ndarray:
+def tutte(
+    mesh: SurfaceMesh,
+    conformal: np.ndarray | None = None,
+    factorize: Callable | None = None,
+) -> np.ndarray:
     """Tutte's embedding with mean-value weights (Floater 2003): one-to-one on any disk-like
     triangle mesh, whatever its shape. Returns pattern coordinates ``(n, 2)``.
 
@@ -282,6 +286,9 @@ def tutte(mesh: SurfaceMesh, conformal: np.ndarray | None = None) -> np.ndarray:
     keeps the cells' orientation and is scaled to the 3D area. Quads are split along a diagonal
     for the weights; a strongly non-convex quad may still fold (it is checked by the caller).
     ``conformal``: the conformal map (:func:`lscm`) if the caller has it already.
+    ``factorize``: a function from the (unsymmetric) system matrix to its solver ``rhs ↦ x``
+    (default :func:`factorized`, SuperLU; the solve passes PARDISO's LU where it has PARDISO,
+    :func:`vares.solver.linear.unsymmetric_factorizer`).
     """
     import scipy.sparse as sp
 
@@ -298,7 +305,7 @@ def tutte(mesh: SurfaceMesh, conformal: np.ndarray | None = None) -> np.ndarray:
     coordinates = np.empty((n, 2))
     coordinates[outer] = boundary_xy
     system = laplacian[inner][:, inner].tocsc()
-    coordinates[inner] = factorized(system)(np.asarray(rhs))
+    coordinates[inner] = (factorize or factorized)(system)(np.asarray(rhs))
     coordinates = coordinates[: mesh.num_points]
     area = signed_area(mesh, coordinates)
     if area < 0:

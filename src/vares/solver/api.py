@@ -25,7 +25,7 @@ from ..mechanics.rigid import rigid_modes
 from ..options import split_settings, takes_options
 from .alignment import align_warp, fibre_angle, initial_fibres, rotated
 from .continuation import continuation_ratios, solve_in_stages
-from .linear import get_solver, quiet_blas
+from .linear import get_solver, quiet_blas, unsymmetric_factorizer
 from .newton import Failure, NewtonContext, describe_cells, exact_tangent_below
 from .options import SolveOptions
 from .result import IterationRecord, PatternResult
@@ -153,7 +153,8 @@ def _solve(mesh, material, thickness, prestress, options, callback, given) -> Pa
         # Tutte's embedding starts on the right side of every fold (not for pseudo-time, whose
         # steps start from a projection)
         conformal = start.coordinates if start.kind == "lscm" else None  # its boundary's shape
-        retry = run.attempt(Start(tutte(mesh, conformal), "tutte", None), restart=True)
+        lu = unsymmetric_factorizer(options.linear_solver)
+        retry = run.attempt(Start(tutte(mesh, conformal, lu), "tutte", None), restart=True)
         if retry.reason is None or retry.energy < attempt.energy:
             attempt = retry
     return PatternResult(

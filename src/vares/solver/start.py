@@ -33,7 +33,7 @@ from ..geometry.mesh import SurfaceMesh
 from ..geometry.rigid_fit import rigid_fit
 from ..mechanics.rigid import rigid_modes
 from ..options import OptionsError
-from .linear import IndefiniteMatrixError, LinearSolver, get_solver
+from .linear import IndefiniteMatrixError, LinearSolver, get_solver, unsymmetric_factorizer
 from .options import SolveOptions
 
 __all__ = ["ARAP_STEPS", "PROJECTION_MIN_AREA_RATIO", "Start", "arap_refined", "initial_guess"]
@@ -201,12 +201,14 @@ def _make(
 ) -> Start:
     """A start of the given kind (Tutte's reuses the ``conformal`` map when it was made). The
     conformal map's normal equations are factorised by ``solver`` (default SciPy's SuperLU);
-    Tutte's (mean-value weights: not symmetric) by SuperLU."""
+    Tutte's (mean-value weights: not symmetric) by PARDISO's LU where ``solver`` is PARDISO,
+    else by SuperLU."""
     if kind == "projection":
         return Start(plane.project(mesh.points), "projection", plane)
     if kind == "lscm":
         return Start(lscm(mesh, None if solver is None else _factorizer(solver)), "lscm", None)
-    return Start(tutte(mesh, conformal), "tutte", None)
+    lu = None if solver is None else unsymmetric_factorizer(solver.name)
+    return Start(tutte(mesh, conformal, lu), "tutte", None)
 
 
 def _given(mesh: SurfaceMesh, options: SolveOptions, given: np.ndarray) -> Start:
