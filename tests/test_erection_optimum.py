@@ -422,6 +422,36 @@ def test_the_shape_bound_holds_where_the_penalty_overshoots():
     assert max(r.deviation_max for r in optimum.history if r.accepted) <= 1.2 * start * 1.005
 
 
+def test_a_step_the_bound_cuts_short_does_not_end_the_optimisation(monkeypatch):
+    """A step cut by the shape bound promises little because nodes meet the bound, not because
+    the optimum is near: it neither ends the optimisation by its model's promise (the uncut
+    step's counts) nor by its small gain. Here the bound cuts the second step to 2 % of itself
+    (where it would promise less than the 1 % the stopping rule asks for): the optimiser goes
+    on past it to nearly the objective it reaches uncut; with the cut step's promise counted,
+    it stopped there."""
+    from vares.analysis import erection_bound
+
+    mesh = vares.examples.hypar(size=10.0, rise=0.06, n=8)
+    solved = vares.solve(mesh, vares.materials.StVenantKirchhoff(E=600.0, nu=0.3), prestress=2.0)
+    free = optimise_for_erection(solved, shape_bound=10.0)  # a bound never reached
+    assert free.converged and free.iterations >= 3
+    calls = []
+    original = erection_bound.ShapeBound.largest_step
+
+    def cut_second(self, deviation, predicted):
+        calls.append(None)
+        value = original(self, deviation, predicted)
+        return 0.02 * value if len(calls) == 2 else value
+
+    monkeypatch.setattr(erection_bound.ShapeBound, "largest_step", cut_second)
+    cut = optimise_for_erection(solved, shape_bound=10.0)
+    start = cut.history[0].objective
+    assert cut.converged and len(calls) > 2 and cut.iterations > 2
+    assert cut.history[2].step_strain < 0.05 * free.history[2].step_strain  # cut it was
+    gained, free_gain = start - cut.history[-1].objective, start - free.history[-1].objective
+    assert gained > 0.95 * free_gain
+
+
 def test_nodes_held_at_the_bound_keep_their_linearised_deviation():
     """``∂d_i/∂X`` by the adjoint against the deviations' change the forward product predicts,
     and a preconditioned LSQR step solved with nodes held (:class:`HeldNodes`) changes their
