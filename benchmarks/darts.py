@@ -26,6 +26,8 @@ largest).
     python benchmarks/darts.py --mould double-dome --radial 35 --law ncf woven
     python benchmarks/darts.py --rings 30 --turned 0 15 30 45 --length 35
     python benchmarks/darts.py --mould double-dome --mirrored 40 30 --law ncf ncf-stiffening
+    python benchmarks/darts.py --mould double-dome --splice x y --cell-size 5 4 --law ncf woven
+    python benchmarks/darts.py --mould double-dome --splice x --law ncf --picture docs/images
 
 (``--radial``: on the double dome, four given darts along the rays from the domes' centres
 ``(±55, 0)`` at ``±--ray-angle`` (default 36.9°, towards the most sheared cells) to the x-axis,
@@ -143,10 +145,18 @@ def main() -> None:
     parser.add_argument("--side", type=float, nargs="+", help="side darts' plan depths (mm)")
     parser.add_argument("--side-x", type=float, nargs="+", default=[55.0], help="their x (mm)")
     parser.add_argument(
+        "--splice", choices=("x", "y"), nargs="+", help="double dome: splice along these axes"
+    )
+    parser.add_argument(
         "--locking-stiffness", type=float, default=100.0, help="locking laws' stiffness at 50°"
     )
     args = parser.parse_args()
     LAWS.update(locking_laws(args.locking_stiffness))
+    if args.splice:
+        runs = itertools.product(args.cell_size, args.law, args.splice)
+        for index, (size, law, along) in enumerate(runs):
+            splice(size, law, args.locking[0], along, args.picture if index == 0 else None)
+        return
     if args.side:
         for size, law, depth in itertools.product(args.cell_size, args.law, args.side):
             side(size, law, args.locking[0], depth, args.side_x)
@@ -280,6 +290,62 @@ def side(cell_size: float, law: str, locking: float, depth: float, xs: list[floa
         f"sides at x = ±{', ±'.join(f'{v:g}' for v in xs)}, {depth:g} mm deep: {text}"
     )
     quadrants(darted)
+
+
+def splice(cell_size: float, law: str, locking: float, along: str, picture: Path | None) -> None:
+    """The double dome spliced along a plane of symmetry (``along`` x: y = 0, through both domes;
+    y: x = 0, across the saddle; ``vares.geometry.double_dome.axis_splice``): the largest shear
+    of the whole ply and the share of its area beyond the locking angle that is negatively
+    curved; per piece the largest shear, its yarn strains (cells and nodal means), iterations,
+    and the kinematic net's largest shear on the piece (``drape_pieces``: from the piece's node
+    nearest its nodes' centroid, warp along x, spacing 2 mm). With ``picture``:
+    ``splices_double_dome.png`` there (the run passes it to the first mesh, law and axis
+    only)."""
+    from vares.analysis.darts import over_locking_curvature
+    from vares.analysis.drape_options import DrapeOptions
+    from vares.analysis.splices import drape_pieces, solve_with_splices, yarn_strain
+    from vares.geometry.double_dome import axis_splice
+
+    mesh, warp = mould("double-dome", 0, cell_size)
+    clock = time.perf_counter()
+    ply = solve_with_splices(
+        mesh,
+        LAWS[law](),
+        locking_angle=locking,
+        polylines=[axis_splice(along)],
+        warp_direction=warp,
+    )
+    seconds = time.perf_counter() - clock
+    if picture is not None:
+        import matplotlib.pyplot as plt
+
+        from vares.io.dart_plots import plot_splices
+
+        figure = plot_splices(ply)
+        figure.savefig(picture / "splices_double_dome.png")
+        plt.close(figure)
+    shares = over_locking_curvature(ply.before, locking)
+    whole, whole_mean = yarn_strain(ply.before), yarn_strain(ply.before, nodal_mean=True)
+    print(
+        f"double dome {cell_size:g} ({mesh.num_cells} cells), {law}, spliced along {along}: "
+        f"whole ply {ply.max_shear_before:.2f}° ({ply.before.iterations} it, converged "
+        f"{ply.before.converged}; yarn strain largest {100 * whole.max():.2f} %, nodal mean "
+        f"{100 * whole_mean.max():.2f} %); beyond {locking:g}°: "
+        f"{100 * shares['negative']:.0f} % negatively, {100 * shares['positive']:.0f} % "
+        f"positively curved; pieces {ply.max_shear_after:.2f}°, relieved {ply.relieved}; "
+        f"{seconds:.1f} s in all, {ply.seconds:.1f} s for the pieces"
+    )
+    ply = drape_pieces(ply, DrapeOptions(spacing=2.0, locking_angle=locking), warp)
+    for piece, result, net in zip(ply.pieces, ply.results, ply.nets, strict=True):
+        strain, mean = yarn_strain(result), yarn_strain(result, nodal_mean=True)
+        print(
+            f"  {piece.name}: {result.mesh.num_cells} cells, largest shear "
+            f"{np.abs(result.fields['shear_angle']).max():.2f}° ({result.iterations} it, "
+            f"converged {result.converged}); yarn strain beyond 2 %: "
+            f"{100 * np.mean(strain > 0.02):.2f} % of the cells, largest {100 * strain.max():.2f} "
+            f"%, nodal mean {100 * mean.max():.2f} %; kinematic net from "
+            f"{np.round(net.seed, 2).tolist()}: {net.producibility.max_shear:.2f}°"
+        )
 
 
 def mirrored(cell_size: float, laws: list[str], locking: float, tips: list[float]) -> None:

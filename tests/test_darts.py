@@ -210,6 +210,9 @@ def test_darts_bring_the_hemisphere_below_the_locking_angle(hemisphere_darts):
     # the darts' lips meet again when the pattern is erected: the mesh is the mould's surface
     assert darted.after.mesh.area == pytest.approx(darted.before.mesh.area, rel=1e-9)
     assert not darted.after.overlap
+    # a sphere: the sheared area is positively curved, where darts relieve it
+    assert darted.summary()["over_locking_curvature"]["positive"] == pytest.approx(1.0)
+    assert not darted.needs_splices
 
 
 def test_a_dart_that_is_cut_but_not_opened_relieves_nothing(hemisphere_darts):

@@ -1,6 +1,6 @@
-"""The options of a ply's darts, declared once (see :mod:`vares.options`): the flags of
-``vares drape`` (``--darts auto``, ``--dart-lines FILE``) and the keywords of
-:func:`vares.analysis.darts.solve_with_darts`."""
+"""The options of a ply's darts and splices, declared once (see :mod:`vares.options`): the flags
+of ``vares drape`` (``--darts auto``, ``--dart-lines FILE``, ``--splice-lines FILE``) and the
+keywords of :func:`vares.analysis.darts.solve_with_darts`."""
 
 from __future__ import annotations
 
@@ -31,6 +31,14 @@ class DartOptions(Options):
         "path",
         "Dart lines of your own: a curves file (points 'x y z', a blank line between two "
         "lines, or a 3dm file), each from the boundary into the mould; replaces --darts auto.",
+        section="drape",
+    )
+    splice_lines: str | None = option(
+        None,
+        "path",
+        "Splice lines: a curves file (as --dart-lines), each from the boundary across the mould "
+        "to the boundary; the ply is cut into pieces along them and each piece's pattern solved "
+        "(for shear darts cannot relieve: where the mould is negatively curved).",
         section="drape",
     )
     dart_tip: float = option(
@@ -69,8 +77,15 @@ class DartOptions(Options):
             raise OptionsError("dart_tip", f"must be at most 1; got {self.dart_tip}")
         if self.darts == "auto" and self.dart_lines is not None:
             raise OptionsError(None, "give --darts auto or --dart-lines, not both")
+        if self.splice_lines is not None and self.wanted:
+            raise OptionsError(None, "give darts or --splice-lines, not both")
 
     @property
     def wanted(self) -> bool:
         """Whether darts are asked for (placed or given)."""
         return self.darts == "auto" or self.dart_lines is not None
+
+    @property
+    def needs_fabric(self) -> bool:
+        """Whether the ply's pattern is solved: for darts or for splices."""
+        return self.wanted or self.splice_lines is not None

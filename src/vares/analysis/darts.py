@@ -36,6 +36,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ..geometry.curvature import curvature_sign_shares
 from ..geometry.drawn_lines import closest_points
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.slits import SlitMesh, open_slits, walk_line
@@ -50,17 +51,31 @@ from .dart_options import DartOptions
 #: Cells at or beyond the locking angle belong to one region when cells whose smoothed shear is
 #: at least this fraction of it join them.
 JOIN_FRACTION = 0.9
+#: Darts that leave the shear at or beyond the locking angle where more than this share of the
+#: area beyond it is negatively curved are answered with the advice to splice the ply.
+NEGATIVE_SHARE = 0.5
 
 __all__ = [
+    "NEGATIVE_SHARE",
     "DartOptions",
     "DartRound",
     "DartedPattern",
     "darts_from_polylines",
     "erected_yarns",
+    "over_locking_curvature",
     "place_darts",
     "smoothed",
     "solve_with_darts",
 ]
+
+
+def over_locking_curvature(result: PatternResult, locking_angle: float) -> dict[str, float]:
+    """The shares of the area at or beyond ``locking_angle`` of a pattern that lie on positively
+    curved, negatively curved and flat parts of its mould
+    (:func:`vares.geometry.curvature.curvature_sign_shares`): darts relieve the first kind, not
+    the second (:mod:`vares.analysis.splices`)."""
+    shear = np.abs(np.nan_to_num(np.asarray(result.fields["shear_angle"], dtype=float)))
+    return curvature_sign_shares(result.mesh, shear >= locking_angle)
 
 
 def erected_yarns(
@@ -309,7 +324,26 @@ class DartedPattern:
             "seconds_before": self.before.elapsed,
             "rounds": [vars(r) for r in self.rounds],
             "chosen_round": None if self.after is None else self.chosen % len(self.rounds),
+            "over_locking_curvature": self.over_locking_curvature(),
         }
+
+    def over_locking_curvature(self) -> dict[str, float] | None:
+        """The shares of the area at or beyond the locking angle in the pattern without darts
+        that lie on positively curved, negatively curved and flat parts of the mould (None when
+        there is none): darts relieve the first kind, not the second
+        (:mod:`vares.analysis.splices`)."""
+        if not self.max_shear_before >= self.locking_angle:
+            return None
+        return over_locking_curvature(self.before, self.locking_angle)
+
+    @property
+    def needs_splices(self) -> bool:
+        """Whether the darts left the shear at or beyond the locking angle where most of the
+        area beyond it is negatively curved (more than :data:`NEGATIVE_SHARE`)."""
+        shares = self.over_locking_curvature()
+        return bool(
+            not self.relieved and shares is not None and shares["negative"] > NEGATIVE_SHARE
+        )
 
 
 @takes_options(DartOptions)
@@ -339,6 +373,8 @@ def solve_with_darts(
     solve_settings = {k: v for k, v in settings.items() if k not in dart_keys}
     if options.dart_lines is not None and polylines is None:
         raise ValueError("dart_lines names a file: pass its lines as polylines (read_curves)")
+    if options.splice_lines is not None:
+        raise ValueError("splice_lines are for solve_with_splices (vares.analysis.splices)")
     mesh = triangulated(mesh)
     given = None if polylines is None else darts_from_polylines(mesh, polylines)  # refused early
     before = solve(mesh, material, thickness, **solve_settings)

@@ -15,8 +15,9 @@ from .outcome import PanelOutcome
 if TYPE_CHECKING:
     from ..analysis.darts import DartedPattern
     from ..analysis.drape import PlyDrape
+    from ..analysis.splices import SplicedPly
 
-__all__ = ["darts_section", "drape_page", "drape_section"]
+__all__ = ["darts_section", "drape_page", "drape_section", "splices_section"]
 
 
 def _ply_rows(ply: PlyDrape, units: str) -> list[tuple[str, object]]:
@@ -96,7 +97,22 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
             "not solved" if darted.after is None else _state(darted.after),
         ),
     ]
+    shares = summary["over_locking_curvature"]
+    if shares is not None:
+        rows.append(
+            (
+                "area at or beyond the locking angle without darts: positively / negatively "
+                "curved / flat",
+                " / ".join(f"{100 * shares[k]:.0f} %" for k in ("positive", "negative", "flat")),
+            )
+        )
     parts = ["<h2>Darts</h2>", table(rows, ident="darts")]
+    if darted.needs_splices:
+        parts.append(
+            "<p class='warning'>Most of the area at or beyond the locking angle is negatively "
+            "curved: a dart takes out fabric the mould needs there. Splice the ply instead "
+            "(<code>--splice-lines</code>).</p>"
+        )
     if summary["darts"]:
         darts = [
             (str(k), f"{number(length, 4)} {units}", f"{number(opening, 4)} {units}")
@@ -126,20 +142,98 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
     return parts
 
 
+def splices_section(spliced: SplicedPly, units: str) -> list[str]:
+    """The HTML parts on a spliced ply: the largest shear of the whole ply and of every piece,
+    the pieces' yarn strains and solves, and the shear of the pieces on the mould."""
+    summary = spliced.summary()
+    rows = [
+        ("locking angle", f"{number(spliced.locking_angle, 4)}°"),
+        ("largest shear of the whole ply", f"{number(summary['max_shear_before'], 4)}°"),
+        ("largest shear of its pieces", f"{number(summary['max_shear_after'], 4)}°"),
+        ("below the locking angle", "yes" if spliced.relieved else "no"),
+        ("splice lines", summary["splices"]),
+        (
+            "their lengths",
+            ", ".join(f"{number(v, 4)} {units}" for v in summary["splice_lengths"]),
+        ),
+        ("pattern of the whole ply", _state(spliced.before)),
+    ]
+    pieces = [
+        (
+            p["name"],
+            p["cells"],
+            f"{number(p['area'], 6)} {units}²",
+            f"{number(p['max_shear'], 4)}°",
+            _strains(p),
+            p["iterations"],
+            "yes" if p["converged"] else "no",
+            f"{number(p['kinematic']['max_shear'], 4)}°" if "kinematic" in p else "",
+        )
+        for p in summary["pieces"]
+    ]
+    header = (
+        "piece",
+        "cells",
+        "area",
+        "largest shear",
+        "largest yarn strain (nodal mean)",
+        "iterations",
+        "converged",
+        "net's largest shear",
+    )
+    parts = [
+        "<h2>Splices</h2>",
+        table(rows, ident="splices"),
+        table(pieces, header=header, ident="splice-pieces"),
+    ]
+    from ..io.dart_plots import plot_splices  # when a report is written
+
+    caption = "shear on the mould of the whole ply and of its pieces, and the flat pieces"
+    parts.append(figure(plot_splices(spliced, dpi=REPORT_DPI), caption, "figure-splices"))
+    return parts
+
+
+def _strains(piece: dict) -> str:
+    if piece["max_yarn_strain"] is None:
+        return ""
+    cells, mean = piece["max_yarn_strain"], piece["max_yarn_strain_nodal_mean"]
+    return f"{100 * cells:.2f} % ({100 * mean:.2f} %)"
+
+
 def _state(result) -> str:
     return "converged" if result.converged else f"not converged: {result.reason}"
 
 
-def drape_page(ply: PlyDrape, darted: DartedPattern | None, name: str, units: str) -> str:
+def drape_page(
+    ply: PlyDrape,
+    darted: DartedPattern | None,
+    name: str,
+    units: str,
+    *,
+    spliced: SplicedPly | None = None,
+) -> str:
     """The report of ``vares drape --report``: the drape and producibility of the ply on the
-    mould ``name`` and, with darts, :func:`darts_section`."""
+    mould ``name`` and, with darts, :func:`darts_section`; with splices,
+    :func:`splices_section`."""
     warnings = []
-    if darted is not None and not darted.relieved:
+    if (darted is not None and not darted.relieved) or (
+        spliced is not None and not spliced.relieved
+    ):
         warnings.append("the largest shear is not below the locking angle")
-    status = "drape" if darted is None else status_text(darted.final.converged, darted.final.reason)
+    if darted is not None:
+        status = status_text(darted.final.converged, darted.final.reason)
+    elif spliced is not None:
+        stuck = [
+            p.name for p, r in zip(spliced.pieces, spliced.results, strict=True) if not r.converged
+        ]
+        status = status_text(spliced.converged, ", ".join(stuck))
+    else:
+        status = "drape"
     parts = page(name, f"Drape: {name}", status, warnings)
     parts += ["<h2>Kinematic drape and producibility</h2>", table(_ply_rows(ply, units))]
     if darted is not None:
         parts += darts_section(darted, units)
+    if spliced is not None:
+        parts += splices_section(spliced, units)
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -29,7 +29,7 @@ import numpy as np
 
 from .mesh import SurfaceMesh
 
-__all__ = ["double_dome", "double_dome_height", "side_darts"]
+__all__ = ["axis_splice", "double_dome", "double_dome_height", "side_darts"]
 
 
 def double_dome_height(
@@ -152,3 +152,18 @@ def side_darts(
             height = double_dome_height(xs_, y, radius=radius, spacing=spacing)
             lines.append(np.column_stack([xs_, y, height]))
     return lines
+
+
+def axis_splice(
+    along: str = "x", radius: float = 70.0, spacing: float = 110.0, flange: float = 30.0
+) -> np.ndarray:
+    """A splice line on the default double dome's surface along one of its planes of symmetry,
+    from the outline to the outline (of ``double_dome(radius, spacing=…, flange=…)``): ``"x"``
+    the long axis (y = 0, through both domes), ``"y"`` the short one (x = 0, across the saddle);
+    ``(400, 3)``, the ends within 0.1 mm inside the outline (mm)."""
+    if along not in ("x", "y"):
+        raise ValueError(f"a splice runs along 'x' or 'y'; got {along!r}")
+    half = spacing / 2 + radius + flange if along == "x" else radius + flange
+    t = np.linspace(-(half - 0.1), half - 0.1, 400)
+    x, y = (t, np.zeros_like(t)) if along == "x" else (np.zeros_like(t), t)
+    return np.column_stack([x, y, double_dome_height(x, y, radius=radius, spacing=spacing)])

@@ -1,6 +1,7 @@
 """``vares drape``: the kinematic drape of a woven ply on a mould, its producibility, and its
 darts (``--darts auto`` or ``--dart-lines FILE``: the ply's pattern solved with its fabric, then
-again with the darts open). ``--example NAME`` drapes a shipped mould (:data:`DRAPE_EXAMPLES`)
+again with the darts open) or splices (``--splice-lines FILE``: the ply cut into pieces, each
+piece's pattern solved). ``--example NAME`` drapes a shipped mould (:data:`DRAPE_EXAMPLES`)
 from its own seed, warp and spacing."""
 
 from collections.abc import Callable
@@ -19,7 +20,7 @@ from .common import console, guarded, net_line, producibility_table
 from .flags import InputError, build, example_flag, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
-__all__ = ["DRAPE_EXAMPLES", "DrapeExample", "darts_verdict", "drape"]
+__all__ = ["DRAPE_EXAMPLES", "DrapeExample", "darts_verdict", "drape", "splices_verdict"]
 
 
 @dataclass(frozen=True)
@@ -128,7 +129,11 @@ def drape(
     fabric (--fabric, or --material and its parameters), darts are opened where its shear
     reaches the locking angle (or along the given lines) and it is solved again: drape.json
     gets the darts, and darts.vtu (the mould cut open), pattern.dxf (the pattern with layer
-    DART) and darts.png (the shear before and after, the dart lines) are written.
+    DART) and darts.png (the shear before and after, the dart lines) are written. With
+    --splice-lines the ply is cut into pieces along the lines and each piece's pattern is
+    solved: drape.json gets the splices, and splices.vtu (the mould cut into pieces) and
+    pieces.dxf (every piece's pattern) and splices.png (the shear of the whole ply and of the
+    pieces, the flat pieces) are written.
     """
 
     def body() -> None:
@@ -159,18 +164,24 @@ def drape(
         units = values["units"] or (example.units if example is not None else "mm")
         if units not in METRES:
             raise InputError(f"--units must be one of {', '.join(METRES)}; got {units!r}")
-        polylines = None
-        if darting.dart_lines is not None:
+        polylines = splice_lines = None
+        if darting.dart_lines is not None or darting.splice_lines is not None:
             from ...io.curves import read_curves
 
-            polylines = read_curves(darting.dart_lines)
+            if darting.dart_lines is not None:
+                polylines = read_curves(darting.dart_lines)
+            if darting.splice_lines is not None:
+                splice_lines = read_curves(darting.splice_lines)
         mesh = read_mesh(surface) if example is None else example.make()
         label = surface.stem if example is None else name
         output = values["output"]
         paths = [output / "drape.json", output / "drape.vtu"]
         dart_paths = [output / "darts.vtu", output / "pattern.dxf", output / "darts.png"]
+        splice_paths = [output / "splices.vtu", output / "pieces.dxf", output / "splices.png"]
         if darting.wanted:
             paths += dart_paths
+        if splice_lines is not None:
+            paths += splice_paths
         if values["report"]:
             paths.append(output / "drape.html")
         inputs = [] if surface is None else [surface]
@@ -189,31 +200,25 @@ def drape(
         }
         point_data = {"flat_u": result.material_coordinates[:, 0]}
         point_data["flat_v"] = result.material_coordinates[:, 1]
-        darted = None
-        if darting.wanted:
-            from ...analysis.darts import solve_with_darts
-
-            locking, _ = options.locking
-            darted = solve_with_darts(
-                mesh,
-                material,
-                values["thickness"],
-                locking_angle=locking,
-                polylines=polylines,
-                options=darting,
-                warp_direction=tuple(float(v) for v in ply.warp),
-            )
+        darted, spliced = _solve_cuts(
+            mesh, material, values["thickness"], options, darting, ply, polylines, splice_lines
+        )
+        if darted is not None:
             data["darts"] = darted.summary()
+        if spliced is not None:
+            data["splices"] = spliced.summary()
         folder.start()
         try:
             write_surface(folder.staged(paths[1]), mesh, None, fields, point_data)
             write_json(folder.staged(paths[0]), data)
             if darted is not None:
                 _write_darts(folder, dart_paths, darted, units, label)
+            if spliced is not None:
+                _write_splices(folder, splice_paths, spliced, units, label)
             if values["report"]:
                 from ..drape_report import drape_page
 
-                html = drape_page(ply, darted, label, units)
+                html = drape_page(ply, darted, label, units, spliced=spliced)
                 folder.staged(paths[-1]).write_text(html, encoding="utf-8")
             folder.commit()
         finally:
@@ -223,12 +228,36 @@ def drape(
             console.print(net_line(check, result.net.valid.sum(), ply.spacing))
             if darted is not None:
                 _show_darts(darted)
+            if spliced is not None:
+                _show_splices(spliced, units)
             for path in paths:
                 console.print(f"  wrote {path}")
         if darted is not None and not darted.final.converged:
             raise typer.Exit(1)
+        if spliced is not None and not spliced.converged:
+            raise typer.Exit(1)
 
     guarded(body)
+
+
+def _solve_cuts(mesh, material, thickness, options, darting, ply, polylines, splice_lines):
+    """The ply's pattern with its darts open (a DartedPattern), or spliced (a SplicedPly with
+    its pieces' kinematic nets); (None, None) with neither."""
+    locking, _ = options.locking
+    common = {"locking_angle": locking, "warp_direction": tuple(float(v) for v in ply.warp)}
+    if darting.wanted:
+        from ...analysis.darts import solve_with_darts
+
+        darted = solve_with_darts(
+            mesh, material, thickness, polylines=polylines, options=darting, **common
+        )
+        return darted, None
+    if splice_lines is not None:
+        from ...analysis.splices import drape_pieces, solve_with_splices
+
+        spliced = solve_with_splices(mesh, material, thickness, polylines=splice_lines, **common)
+        return None, drape_pieces(spliced, options, ply.warp)
+    return None, None
 
 
 def _material(values: dict[str, Any], darting: DartOptions):
@@ -236,15 +265,23 @@ def _material(values: dict[str, Any], darting: DartOptions):
     darts are refused."""
     options = build(MaterialOptions, values)
     given = [n for n, d in MaterialOptions.defaults().items() if getattr(options, n) != d]
-    if not darting.wanted:
+    if not darting.needs_fabric:
         if given:
-            raise InputError(f"--{given[0].replace('_', '-')} is for darts: add --darts auto")
+            raise InputError(
+                f"--{given[0].replace('_', '-')} is for darts or splices: add --darts auto "
+                "or --splice-lines"
+            )
         return None
+    cuts = "darts" if darting.wanted else "splices"
     if options.law is None and options.fabric is None and options.presets is None:
-        raise InputError("darts need the ply's fabric: give --fabric, or --material and its moduli")
+        raise InputError(
+            f"{cuts} need the ply's fabric: give --fabric, or --material and its moduli"
+        )
     material = options.build(Path.cwd())
     if not material.needs_fibres:
-        raise InputError("darts need a fabric with yarns (an orthotropic or ncf law, or --fabric)")
+        raise InputError(
+            f"{cuts} need a fabric with yarns (an orthotropic or ncf law, or --fabric)"
+        )
     return material
 
 
@@ -271,6 +308,79 @@ def _write_darts(folder, paths: list[Path], darted, units: str, name: str) -> No
     figure = plot_darts(darted)
     figure.savefig(folder.staged(paths[2]))
     plt.close(figure)
+
+
+def _write_splices(folder, paths: list[Path], spliced, units: str, name: str) -> None:
+    import matplotlib.pyplot as plt
+
+    from ...io.dart_plots import plot_splices
+    from ...io.dxf import CutPiece, write_dxf
+    from ...io.meshes import write_surface
+
+    cut = spliced.cut
+    fields = {
+        "piece": cut.panel_ids.astype(float),
+        "shear_angle": spliced.cell_field("shear_angle"),
+    }
+    flat = spliced.flat_coordinates()
+    point_data = {"flat_u": flat[:, 0], "flat_v": flat[:, 1]}
+    write_surface(folder.staged(paths[0]), cut.mesh, None, fields, point_data)
+    pieces = []
+    for piece, result in zip(spliced.pieces, spliced.results, strict=True):
+        largest = float(np.nanmax(np.abs(result.fields["shear_angle"])))
+        label = [f"{name} {piece.name}", f"largest shear {largest:.1f}°"]
+        warp = None if result.fibres is None else result.fibres.warp
+        pieces.append(CutPiece(piece.name, result.mesh, result.material_coordinates, warp, label))
+    write_dxf(folder.staged(paths[1]), pieces, units=units, model_units=units)
+    figure = plot_splices(spliced)
+    figure.savefig(folder.staged(paths[2]))
+    plt.close(figure)
+
+
+def _show_splices(spliced, units: str) -> None:
+    from rich.table import Table
+
+    summary = spliced.summary()
+    table = Table(
+        "piece",
+        "cells",
+        f"area ({units}²)",
+        "largest shear",
+        "largest yarn strain (nodal mean)",
+        "iterations",
+        "converged",
+        "net's largest shear",
+        title=f"splices (locking {spliced.locking_angle:g}°)",
+    )
+    for piece in summary["pieces"]:
+        strain, mean = piece["max_yarn_strain"], piece["max_yarn_strain_nodal_mean"]
+        table.add_row(
+            piece["name"],
+            str(piece["cells"]),
+            f"{piece['area']:.6g}",
+            f"{piece['max_shear']:.2f}°",
+            "" if strain is None else f"{100 * strain:.2f} % ({100 * mean:.2f} %)",
+            str(piece["iterations"]),
+            "yes" if piece["converged"] else "NO",
+            f"{piece['kinematic']['max_shear']:.2f}°" if "kinematic" in piece else "",
+        )
+    console.print(table)
+    console.print(splices_verdict(spliced))
+
+
+def splices_verdict(spliced) -> str:
+    """The line ``vares drape --splice-lines`` prints of a
+    :class:`~vares.analysis.splices.SplicedPly`: the largest shear of the whole ply and of its
+    pieces against the locking angle."""
+    summary = spliced.summary()
+    count = len(summary["pieces"])
+    state = "below" if spliced.relieved else "NOT below"
+    tail = "" if spliced.converged else " (a piece's pattern did NOT converge)"
+    return (
+        f"largest shear {summary['max_shear_before']:.2f}° of the whole ply, "
+        f"{summary['max_shear_after']:.2f}° of its {count} pieces: {state} the locking angle"
+        f"{tail}"
+    )
 
 
 def _show_darts(darted) -> None:
@@ -306,7 +416,14 @@ def darts_verdict(darted) -> str:
         tail = f"{after:.2f}° with the darts open"
     state = "below" if darted.relieved else "NOT below"
     solves = len(darted.rounds)
-    return (
+    verdict = (
         f"largest shear of the pattern {before:.2f}° without darts, {tail}: {state} the "
         f"locking angle ({solves} {'solve' if solves == 1 else 'solves'} with darts)"
     )
+    if darted.needs_splices:
+        negative = summary["over_locking_curvature"]["negative"]
+        verdict += (
+            f"; {100 * negative:.0f} % of the area at or beyond it is negatively curved, where a "
+            "dart takes out fabric the mould needs: splice the ply there (--splice-lines)"
+        )
+    return verdict

@@ -1,0 +1,235 @@
+"""Splices: a ply cut into pieces along lines from its boundary to its boundary, each piece draped
+(its pattern solved) on its own part of the mould.
+
+A dart takes fabric out where a positively curved region holds too much of it; where the sheared
+region is negatively curved (:mod:`vares.geometry.curvature`) a dart takes out what is missing
+already, and its lips would have to overlap in the flat pattern. There the ply is **spliced**:
+cut through, the pieces butted (or overlapped) on the mould, each with its own flat pattern. The
+pieces drape separately, so none has to carry the shear the whole ply takes up over the curvature
+between them.
+
+:func:`solve_with_splices` solves the whole ply (the comparison), draws the splice lines onto the
+mould (:func:`vares.geometry.drawn_lines.curves_on_surface`: the lines' points become nodes, their
+ends go to the boundary), cuts it into pieces along them
+(:func:`vares.geometry.cutting.cut_mesh`) and solves every piece with the same fabric and
+settings. The largest shear of the spliced ply is the largest of its pieces'.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..geometry.cutting import CutMesh, cut_mesh
+from ..geometry.drawn_lines import curves_on_surface
+from ..geometry.mesh import SurfaceMesh
+from ..geometry.surface_lines import CuttingError, triangulated
+from ..materials import Hyperelastic
+from ..solver.api import solve
+from ..solver.result import PatternResult
+from ..structures.panels import Panel, split_panels
+from .darts import smoothed
+
+if TYPE_CHECKING:
+    from .drape import PlyDrape
+    from .drape_options import DrapeOptions
+
+__all__ = [
+    "SPLICE_SNAP",
+    "SplicedPly",
+    "drape_pieces",
+    "solve_with_splices",
+    "yarn_strain",
+]
+
+#: Where a splice line crosses an edge closer than this fraction of the edge's length to a node,
+#: or passes a corner closer than this fraction of the cell's edges, it is moved onto the node
+#: (:data:`vares.geometry.cutting.SNAP` for seams is 0.05): the cut then leaves no slivers,
+#: whose linear triangles scatter the shear of a stiff-yarn fabric (on the shipped double dome
+#: split along y = 0, one sliver of 0.25 mm at 0.05 showed 49.97° beside 29.2° around it).
+SPLICE_SNAP = 0.4
+
+
+def yarn_strain(result: PatternResult, nodal_mean: bool = False) -> np.ndarray | None:
+    """Per cell of a pattern's mesh ``(m,)``: the larger of ``|warp stretch − 1|`` and ``|fill
+    stretch − 1|`` on the mould (None for a law without yarns); with ``nodal_mean`` of the
+    stretches averaged to the nodes and back (:func:`vares.analysis.darts.smoothed`), which
+    leaves out the cell-to-cell scatter of linear triangles with stiff yarns."""
+    fields = result.fields
+    if "warp_stretch" not in fields:
+        return None
+    warp, fill = np.asarray(fields["warp_stretch"]), np.asarray(fields["fill_stretch"])
+    if nodal_mean:
+        warp, fill = smoothed(result.mesh, warp), smoothed(result.mesh, fill)
+    return np.maximum(np.abs(warp - 1.0), np.abs(fill - 1.0))
+
+
+@dataclass(frozen=True)
+class SplicedPly:
+    """A ply before and after it was spliced.
+
+    ``before``: the pattern of the whole ply; ``cut``: the mould cut along the splice lines
+    (``cut.mesh``, ``cut.panel_ids``: the piece of every cell, ``cut.lines``: the lines' node
+    chains); ``pieces``: the pieces (named ``piece-1`` …, in the order of ``cut.panel_ids``) and
+    ``results`` their patterns; ``locking_angle`` in degrees; ``seconds``: the pieces' solves;
+    ``nets``: the kinematic drape of every piece (:func:`drape_pieces`), or None.
+    """
+
+    before: PatternResult
+    cut: CutMesh
+    pieces: list[Panel]
+    results: list[PatternResult]
+    locking_angle: float
+    seconds: float
+    nets: list[PlyDrape] | None = None
+
+    @property
+    def splice_lines(self) -> list[np.ndarray]:
+        """The splice lines on the mould, ``(k, 3)`` each."""
+        return [self.cut.mesh.points[chain] for chain in self.cut.lines]
+
+    @property
+    def converged(self) -> bool:
+        """Whether every piece's pattern converged."""
+        return all(r.converged for r in self.results)
+
+    @property
+    def max_shear_before(self) -> float:
+        return float(np.nanmax(np.abs(self.before.fields["shear_angle"])))
+
+    @property
+    def max_shear_after(self) -> float:
+        """The largest shear of any piece (degrees)."""
+        return max(float(np.nanmax(np.abs(r.fields["shear_angle"]))) for r in self.results)
+
+    @property
+    def relieved(self) -> bool:
+        """Whether every piece converged with its largest shear below the locking angle."""
+        return bool(self.converged and self.max_shear_after < self.locking_angle)
+
+    def cell_field(self, name: str) -> np.ndarray:
+        """A per-cell field of the pieces' patterns on ``cut.mesh``'s cells ``(m, …)``."""
+        first = np.asarray(self.results[0].fields[name])
+        out = np.full((self.cut.mesh.num_cells, *first.shape[1:]), np.nan)
+        for index, result in enumerate(self.results):
+            out[self.cut.panel_ids == index] = np.asarray(result.fields[name])
+        return out
+
+    def flat_coordinates(self) -> np.ndarray:
+        """Every node of ``cut.mesh`` in its piece's flat pattern ``(n, 2)`` (a node on a splice
+        line belongs to both pieces: it gets the last one's coordinates)."""
+        cells = self.cut.mesh.cells["triangle"]
+        out = np.full((self.cut.mesh.num_points, 2), np.nan)
+        for index, result in enumerate(self.results):
+            used = np.unique(cells[self.cut.panel_ids == index])
+            out[used] = result.material_coordinates
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """The numbers for a summary file: per piece its cells, area on the mould, largest shear,
+        area at or beyond the locking angle, largest yarn strain of the cells and of the nodal
+        means (:func:`yarn_strain`; where the law has yarns),
+        Newton iterations and whether it converged, and its kinematic net's seed, largest shear
+        and area share at or beyond the locking angle (with :attr:`nets`); the splice lines'
+        lengths; the largest shear before and after."""
+        pieces = []
+        nets = self.nets or [None] * len(self.pieces)
+        for piece, result, net in zip(self.pieces, self.results, nets, strict=True):
+            shear = np.abs(np.nan_to_num(result.fields["shear_angle"]))
+            area = result.mesh.cell_areas()
+            strain, mean = yarn_strain(result), yarn_strain(result, nodal_mean=True)
+            pieces.append(
+                {
+                    "name": piece.name,
+                    "cells": int(result.mesh.num_cells),
+                    "area": float(area.sum()),
+                    "max_shear": float(shear.max()),
+                    "over_locking_fraction": float(
+                        area[shear >= self.locking_angle].sum() / area.sum()
+                    ),
+                    "max_yarn_strain": None if strain is None else float(strain.max()),
+                    "max_yarn_strain_nodal_mean": None if mean is None else float(mean.max()),
+                    "iterations": int(result.iterations),
+                    "converged": bool(result.converged),
+                }
+            )
+            if net is not None:
+                pieces[-1]["kinematic"] = {
+                    "seed": [float(v) for v in net.seed],
+                    "max_shear": float(net.producibility.max_shear),
+                    "limit_fraction": float(net.producibility.fractions["limit"]),
+                }
+        return {
+            "locking_angle": self.locking_angle,
+            "max_shear_before": self.max_shear_before,
+            "max_shear_after": self.max_shear_after,
+            "relieved": self.relieved,
+            "converged": self.converged,
+            "splices": len(self.cut.lines),
+            "splice_lengths": [
+                float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for p in self.splice_lines
+            ],
+            "pieces": pieces,
+            "iterations_before": int(self.before.iterations),
+            "seconds": self.seconds,
+        }
+
+
+def solve_with_splices(
+    mesh: SurfaceMesh,
+    material: Hyperelastic,
+    thickness: float = 1.0,
+    *,
+    locking_angle: float,
+    polylines: Sequence[np.ndarray],
+    snap: float = SPLICE_SNAP,
+    **settings: Any,
+) -> SplicedPly:
+    """Splice the ply on ``mesh`` (the mould) along ``polylines`` (``(k, 3)`` each, on or near
+    the mould, from its boundary to its boundary; e.g. a curves file's,
+    :func:`vares.io.curves.read_curves`) and solve every piece (:func:`vares.solve` with
+    ``material``, ``thickness`` and the keyword ``settings``, e.g. ``warp_direction``); the whole
+    ply is solved first, for comparison (module docs); ``snap``: :data:`SPLICE_SNAP`. Quads are
+    split into triangles first.
+
+    Raises :class:`~vares.geometry.surface_lines.CuttingError` when there are no lines or they
+    do not cut the mould into pieces.
+    """
+    if not len(polylines):
+        raise CuttingError("splices need at least one splice line")
+    surface = triangulated(mesh)
+    drawn, lines = curves_on_surface(surface, [np.asarray(p, dtype=float) for p in polylines], snap)
+    cut = cut_mesh(drawn, lines, snap)
+    if cut.num_panels < 2:
+        raise CuttingError(
+            "the splice lines do not cut the mould into pieces: draw each from the boundary "
+            "across the mould to the boundary"
+        )
+    before = solve(surface, material, thickness, **settings)
+    pieces = split_panels(
+        cut.mesh, cut.panel_ids, {i: f"piece-{i + 1}" for i in range(cut.num_panels)}
+    )
+    clock = time.perf_counter()
+    results = [solve(piece.mesh, material, thickness, **settings) for piece in pieces]
+    seconds = time.perf_counter() - clock
+    return SplicedPly(before, cut, pieces, results, float(locking_angle), seconds)
+
+
+def drape_pieces(
+    spliced: SplicedPly, options: DrapeOptions, warp_direction: Sequence[float]
+) -> SplicedPly:
+    """``spliced`` with the kinematic drape of every piece (:func:`vares.analysis.drape.drape_ply`
+    with ``options``, the warp ``warp_direction`` unless the options name one, each piece from
+    its own node nearest its nodes' centroid): the industry's reference beside the pieces'
+    patterns."""
+    from .drape import drape_ply
+
+    own = options.replace(seed=None)
+    warp = tuple(float(v) for v in warp_direction)
+    nets = [drape_ply(piece.mesh, own, warp_direction=warp) for piece in spliced.pieces]
+    return dataclasses.replace(spliced, nets=nets)
