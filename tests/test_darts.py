@@ -200,7 +200,7 @@ def test_darts_bring_the_hemisphere_below_the_locking_angle(hemisphere_darts):
     assert darted.before.converged and darted.after.converged
     assert darted.max_shear_before > LOCKING + 5.0
     assert darted.relieved and darted.max_shear_after < LOCKING
-    assert darted.final is darted.after
+    assert darted.final is darted.after and darted.kept
     assert darted.max_shear_before - darted.max_shear_after > 5.0
     assert len(darted.dart_lines) == 4
     for gaps in darted.slits.lip_gaps(darted.after.material_coordinates):

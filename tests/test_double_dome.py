@@ -232,3 +232,27 @@ def test_side_darts_open_on_a_locking_fabric():
         assert gaps[-1] == 0.0  # the tip is one node
     assert darted.after.mesh.area == pytest.approx(mesh.area, rel=1e-9)
     assert not darted.after.overlap
+
+
+def test_darts_that_raise_the_shear_are_not_cut(tmp_path):
+    """``vares drape --darts auto`` on the shipped part: the automatic dart raises the largest
+    shear (measured 57.78° → 62.62°), so the ply is cut without it, as a laminate's ply is:
+    pattern.dxf has no DART layer and says so, drape.json's darts are not kept, and the verdict
+    names the negatively curved walls and the splice."""
+    import json
+
+    import ezdxf
+    from conftest import run
+
+    out = tmp_path / "out"
+    fabric = ["--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
+    result = run("drape", "--example", "double-dome", "--darts", "auto", *fabric, "-o", out)
+    assert result.exit_code == 0, result.stderr
+    data = json.loads((out / "drape.json").read_text())["darts"]
+    assert data["darts"] >= 1 and data["max_shear_after"] > data["max_shear_before"]
+    assert not data["kept"] and not data["relieved"]
+    assert data["over_locking_curvature"]["negative"] > 0.8
+    entities = list(ezdxf.readfile(out / "pattern.dxf").modelspace())
+    assert "DART" not in {e.dxf.layer for e in entities}
+    texts = [e.dxf.text for e in entities if e.dxftype() == "TEXT"]
+    assert any(t.startswith("darts tried, not kept") for t in texts)

@@ -295,6 +295,15 @@ class DartedPattern:
         return self.before if self.after is None else self.after
 
     @property
+    def kept(self) -> bool:
+        """Whether the ply is cut with the darts: some were opened, the solve with them
+        converged, and they lower its largest shear (darts that leave it as high or higher are
+        reported, not cut)."""
+        if self.after is None or not self.after.converged:
+            return False
+        return bool(self.max_shear_after < self.max_shear_before)
+
+    @property
     def relieved(self) -> bool:
         """Whether the largest shear ends below the locking angle (with or without darts)."""
         shear = self.max_shear_before if self.after is None else self.max_shear_after
@@ -315,6 +324,7 @@ class DartedPattern:
             "max_shear_before": self.max_shear_before,
             "max_shear_after": self.max_shear_after,
             "relieved": self.relieved,
+            "kept": self.kept,
             "darts": len(self.dart_lines),
             "dart_lengths": [
                 float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for p in self.dart_lines

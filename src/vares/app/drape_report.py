@@ -91,6 +91,14 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
         ),
         ("below the locking angle", "yes" if darted.relieved else "no"),
         ("darts", summary["darts"]),
+        (
+            "cut with the darts",
+            "yes"
+            if darted.kept
+            else "no dart opened"
+            if darted.after is None
+            else "no (they do not lower the largest shear)",
+        ),
         ("pattern without darts", _state(darted.before)),
         (
             "pattern with the darts open",

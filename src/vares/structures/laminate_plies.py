@@ -36,11 +36,9 @@ class Ply:
 
 
 def darts_used(darted: DartedPattern | None) -> bool:
-    """Whether a ply is cut with the darts of ``darted``: some were opened, the solve with them
-    converged, and they lower the ply's largest shear."""
-    if darted is None or darted.after is None or not darted.after.converged:
-        return False
-    return bool(darted.max_shear_after < darted.max_shear_before)
+    """Whether a ply is cut with the darts of ``darted``
+    (:attr:`~vares.analysis.darts.DartedPattern.kept`)."""
+    return darted is not None and darted.kept
 
 
 @dataclass

@@ -286,24 +286,32 @@ def _material(values: dict[str, Any], darting: DartOptions):
 
 
 def _write_darts(folder, paths: list[Path], darted, units: str, name: str) -> None:
+    """darts.vtu (the mould opened along the darts, the shear with them open), pattern.dxf (the
+    pattern to cut: with its darts where they are kept, else the pattern without them) and
+    darts.png."""
     import matplotlib.pyplot as plt
 
     from ...io.dart_plots import plot_darts
     from ...io.dxf import CutPiece, write_dxf
     from ...io.meshes import write_surface
 
-    final = darted.final
-    fields = {"shear_angle": final.fields["shear_angle"]}
-    flat = final.material_coordinates
+    tried = darted.final
+    fields = {"shear_angle": tried.fields["shear_angle"]}
+    flat = tried.material_coordinates
     point_data = {"flat_u": flat[:, 0], "flat_v": flat[:, 1]}
-    write_surface(folder.staged(paths[0]), final.mesh, None, fields, point_data)
+    write_surface(folder.staged(paths[0]), tried.mesh, None, fields, point_data)
     summary = darted.summary()
-    label = [
-        f"{summary['darts']} darts, largest shear {np.nanmax(np.abs(fields['shear_angle'])):.1f}°"
-    ]
-    piece = CutPiece(
-        name, final.mesh, flat, final.fibres.warp, label, darts=darted.dart_pattern_lines()
-    )
+    cut = darted.after if darted.kept else darted.before
+    largest = float(np.nanmax(np.abs(cut.fields["shear_angle"])))
+    if darted.kept or darted.after is None:
+        label = [f"{summary['darts']} darts, largest shear {largest:.1f}°"]
+    else:
+        label = [
+            f"no darts, largest shear {largest:.1f}°",
+            f"darts tried, not kept: {summary['max_shear_after']:.1f}° with them",
+        ]
+    lines = darted.dart_pattern_lines() if darted.kept else []
+    piece = CutPiece(name, cut.mesh, cut.material_coordinates, cut.fibres.warp, label, darts=lines)
     write_dxf(folder.staged(paths[1]), [piece], units=units, model_units=units)
     figure = plot_darts(darted)
     figure.savefig(folder.staged(paths[2]))
@@ -420,6 +428,8 @@ def darts_verdict(darted) -> str:
         f"largest shear of the pattern {before:.2f}° without darts, {tail}: {state} the "
         f"locking angle ({solves} {'solve' if solves == 1 else 'solves'} with darts)"
     )
+    if darted.after is not None and not darted.kept:
+        verdict += "; the darts are NOT kept (they do not lower it): pattern.dxf is without them"
     if darted.needs_splices:
         negative = summary["over_locking_curvature"]["negative"]
         verdict += (
