@@ -19,7 +19,12 @@ from .newton import Failure, NewtonContext
 from .strategies import Attempt, follow_plan
 
 __all__ = [
+    "ALIGNMENT_JUMP",
     "ALIGNMENT_TOLERANCE",
+    "JUMP_ANGLE",
+    "JUMP_RATIO",
+    "MAX_TURNS",
+    "SECANT_TURNS",
     "TURNED",
     "align_warp",
     "fibre_angle",
@@ -29,6 +34,20 @@ __all__ = [
 
 #: The mean erected warp follows a prescribed direction to this angle (radians).
 ALIGNMENT_TOLERANCE = 1e-10
+#: Turns of the yarns by the secant iteration alone, and in all.
+SECANT_TURNS = 15
+MAX_TURNS = 40
+#: Two warp angles this close (degrees) whose deviations have both signs and are both larger
+#: than ``JUMP_RATIO`` times the angle between them are taken for a jump of the drape between
+#: two patterns (a yarn turned by 1e-3° moves by 9 µm over 0.5 m; where the drape changes
+#: smoothly, the deviation changes by about the angle the yarns turn, 16 times that on the
+#: hemisphere's half spliced through its pole).
+JUMP_ANGLE = 1e-3
+JUMP_RATIO = 100.0
+#: Across such a jump, the pattern whose mean warp deviates less is kept if it deviates by at
+#: most this angle (degrees; the hemisphere's half spliced through its pole, stiff yarns:
+#: +0.12° and −0.094° on either side of the jump).
+ALIGNMENT_JUMP = 0.5
 #: How each turn of the yarns is solved from the previous pattern: globalised Newton, then
 #: damping from where it stopped.
 TURNED = (
@@ -73,19 +92,39 @@ def align_warp(
     """Turn the fibres in the pattern until the mean erected warp follows ``direction``.
 
     Secant iteration on the warp angle (the deviation changes by about the same angle as the
-    warp); each new angle is solved from the previous pattern, whose rotation stays held, by
-    the attempts :data:`TURNED` (:func:`~vares.solver.strategies.follow_plan`). Returns the
-    pattern, the fibres and the final mean deviation (radians).
+    warp), :data:`SECANT_TURNS` turns at most; each new angle is solved from the previous
+    pattern, whose rotation stays held, by the attempts :data:`TURNED`
+    (:func:`~vares.solver.strategies.follow_plan`). Where that does not align it and two of
+    its angles bracket the alignment (deviations of both signs), the bracket is halved, a
+    secant step taken instead where it stays inside and the last one halved the deviation, up
+    to :data:`MAX_TURNS` turns in all. Where the bracket closes to :data:`JUMP_ANGLE` with the
+    deviations at both ends still more than :data:`JUMP_RATIO` times its width, the drape
+    jumps between two patterns there (the pattern a turn reaches depends on where its solve
+    starts: stiff yarns on a piece of a sphere): the side whose mean warp deviates less is kept
+    if that is within :data:`ALIGNMENT_JUMP`, else the alignment fails. Returns the pattern,
+    the fibres and the final mean deviation (radians).
     """
     problem = make_problem(fibres)
     offset = _offset(fibres)
     theta = fibre_angle(fibres.warp)
     deviation, _ = warp_deviation(problem.mesh, coordinates, fibres.warp, direction)
     slope = 1.0
-    for outer in range(1, 16):
+    sides: dict[bool, tuple[float, float, np.ndarray, Fibres]] = {}  # by the deviation's sign
+    fast = True
+    for outer in range(1, MAX_TURNS + 1):
         if abs(deviation) <= ALIGNMENT_TOLERANCE:
             break
+        sides[deviation > 0] = (theta, deviation, coordinates, fibres)
         new_theta = theta - np.degrees(deviation / slope)
+        if outer > SECANT_TURNS:
+            if len(sides) < 2:
+                break
+            low, high = sorted((sides[True][0], sides[False][0]))
+            nearest = min(abs(np.degrees(side[1])) for side in sides.values())
+            if high - low <= JUMP_ANGLE and nearest > JUMP_RATIO * (high - low):
+                return _across_jump(sides)
+            if not (fast and low < new_theta < high):
+                new_theta = 0.5 * (low + high)
         fibres = Fibres.from_angles(new_theta, new_theta + offset)
         if problem.orientation_matters:
             problem = make_problem(fibres)
@@ -97,11 +136,28 @@ def align_warp(
         new_deviation, _ = warp_deviation(problem.mesh, coordinates, fibres.warp, direction)
         if new_theta != theta and new_deviation != deviation:
             slope = (new_deviation - deviation) / np.radians(new_theta - theta)
+        fast = abs(new_deviation) <= 0.5 * abs(deviation)
         theta, deviation = new_theta, new_deviation
     if abs(deviation) > ALIGNMENT_TOLERANCE:
         raise Failure(
             f"the warp could not be aligned with the direction (mean deviation "
             f"{np.degrees(deviation):.3g}°)",
+            coordinates,
+        )
+    return coordinates, fibres, deviation
+
+
+def _across_jump(sides: dict) -> tuple[np.ndarray, Fibres, float]:
+    """The pattern of the bracket's side whose mean warp deviates less, where the deviation
+    jumps across the bracket (:func:`align_warp`); a failure if it deviates by more than
+    :data:`ALIGNMENT_JUMP`."""
+    theta, deviation, coordinates, fibres = min(sides.values(), key=lambda side: abs(side[1]))
+    plus, minus = (np.degrees(sides[key][1]) for key in (True, False))
+    if abs(np.degrees(deviation)) > ALIGNMENT_JUMP:
+        raise Failure(
+            f"the warp could not be aligned with the direction: the drape jumps between two "
+            f"patterns as the yarns turn through {theta:.6g}° in the pattern (mean deviation "
+            f"{plus:+.3g}° on one side, {minus:+.3g}° on the other)",
             coordinates,
         )
     return coordinates, fibres, deviation
