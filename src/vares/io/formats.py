@@ -1,7 +1,10 @@
 """Readers for the polygon formats that meshio reads too narrowly or not at all: Wavefront OBJ
 (faces with texture and normal indices ``f 1/1/1 …``, negative indices, polygons), OFF (quads
-and polygons, ``COFF``/``NOFF`` variants, per-face colours ignored) and DXF (3D faces, polyface
-and polygon meshes, MESH entities of the model space, with the drawing's units).
+and polygons, ``COFF``/``NOFF`` variants, per-face colours ignored), DXF (3D faces, polyface
+and polygon meshes, MESH entities of the model space, with the drawing's units) and Kratos
+Multiphysics' MDPA (the surface elements of a membrane or shell model: meshio takes Kratos'
+own element names, ``MembraneElement3D3N``, for 3-node lines, and reads the conditions that
+repeat the elements as cells too).
 
 Each returns a :class:`PolygonSoup`: points, triangle and quad blocks and the longer polygons,
 in the order the faces appear in the file block by block (triangles, quads, polygons).
@@ -18,7 +21,15 @@ import numpy as np
 from ..geometry.mesh import MeshError
 from .dxf import INSUNITS
 
-__all__ = ["DXF_UNITS", "PolygonSoup", "check_stl", "read_dxf", "read_obj", "read_off"]
+__all__ = [
+    "DXF_UNITS",
+    "PolygonSoup",
+    "check_stl",
+    "read_dxf",
+    "read_mdpa",
+    "read_obj",
+    "read_off",
+]
 
 
 @dataclass
@@ -175,6 +186,64 @@ def read_off(path: Path) -> PolygonSoup:
         size = _numbers(tokens[:1], path, number, int)[0]
         faces.append(_numbers(tokens[1 : 1 + size], path, number, int))
     return _soup(points, faces, path)
+
+
+#: Kratos element names (their part before the dimension, ``…3D4N``) of 4-node surface
+#: elements; any other 4-node element is a solid's (a tetrahedron).
+_MDPA_SURFACES = ("membrane", "shell", "surface", "quadrilateral")
+
+
+def read_mdpa(path: Path) -> PolygonSoup:
+    """A Kratos MDPA file: its nodes (``Begin Nodes``: ``id x y z``, any ids) and the cells of
+    its ``Begin Elements NAME`` blocks (``id property n1 … nk``): 3 nodes a triangle, 4 a quad
+    when NAME is a membrane's, shell's or surface's. Conditions, sub-model parts and data blocks
+    are skipped; a line element block (2 nodes, or NAME with "Line") is left out; a block of
+    solid elements is refused."""
+    node_ids: list[int] = []
+    points: list[list[float]] = []
+    faces: list[list[int]] = []  # node ids, renumbered below
+    blocks: list[str] = []  # the open blocks, outermost first (sub-model parts nest)
+    name = ""
+    for number, line in enumerate(_text(path).splitlines(), start=1):
+        tokens = line.split("//")[0].split()
+        if not tokens:
+            continue
+        if tokens[0] == "Begin":
+            blocks.append(tokens[1] if len(tokens) > 1 else "")
+            name = tokens[2] if len(tokens) > 2 else ""
+            continue
+        if tokens[0] == "End":
+            if blocks:
+                blocks.pop()
+            continue
+        block = blocks[0] if len(blocks) == 1 else None  # the model part's own blocks only
+        if block == "Nodes":
+            values = _numbers(tokens[:4], path, number)
+            if len(values) != 4:
+                raise MeshError(f"{path}, line {number}: a node needs an id and x y z")
+            node_ids.append(int(values[0]))
+            points.append(values[1:])
+        elif block == "Elements":
+            ids = _numbers(tokens, path, number, int)[2:]
+            solid = len(ids) > 4 or (
+                len(ids) == 4 and not any(k in name.lower() for k in _MDPA_SURFACES)
+            )
+            if solid:
+                raise MeshError(
+                    f"{path}, line {number}: {name} is a solid element ({len(ids)} nodes); "
+                    "vares needs the surface (membrane or shell elements)"
+                )
+            if len(ids) >= 3 and "line" not in name.lower():
+                faces.append(ids)
+    if not faces:
+        raise MeshError(f"{path} holds no membrane or shell elements (Begin Elements …3D3N)")
+    index = {node: k for k, node in enumerate(node_ids)}
+    if len(index) < len(node_ids):
+        raise MeshError(f"{path}: node ids repeat")
+    missing = sorted({i for face in faces for i in face if i not in index})
+    if missing:
+        raise MeshError(f"{path}: elements refer to node {missing[0]}, which the file lacks")
+    return _soup(points, [[index[i] for i in face] for face in faces], path)
 
 
 #: A line of an ASCII STL file that does not begin with one of its keywords.

@@ -1,5 +1,5 @@
-"""Mesh files: reading surfaces (any format meshio reads, and Rhino ``.3dm``), writing surfaces
-and patterns, reading a pattern back."""
+"""Mesh files: reading surfaces (any format meshio reads, Rhino ``.3dm``, Kratos ``.mdpa``),
+writing surfaces and patterns, reading a pattern back."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from ..geometry.repair import RepairReport
 from ..geometry.repair import repair as repair_surface
 from ..units import METRES
 from .files import write_with
-from .formats import check_stl, read_dxf, read_obj, read_off
+from .formats import check_stl, read_dxf, read_mdpa, read_obj, read_off
 from .vtu import FACTOR_FIELD, declare_units, declared_units, split_string_fields
 
 __all__ = [
@@ -201,8 +201,9 @@ def read_raw(path: Path) -> RawSurface:
             units=units,
             cell_names={"layer": dict(enumerate(names))},
         )
-    if suffix in (".obj", ".off"):
-        soup = read_obj(path) if suffix == ".obj" else read_off(path)
+    if suffix in (".obj", ".off", ".mdpa"):
+        readers = {".obj": read_obj, ".off": read_off, ".mdpa": read_mdpa}
+        soup = readers[suffix](path)
         return RawSurface(soup.points, soup.cells, soup.polygons)
     if suffix == ".stl":
         check_stl(path)
