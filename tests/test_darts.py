@@ -62,6 +62,28 @@ def test_a_walked_line_is_straight_and_as_long_as_asked():
     assert through.points[-1, 1] < 1.0 and through.points[-1, 1] > 0.85
 
 
+def test_a_dart_along_a_row_of_nodes_starts_on_the_boundary_and_runs_its_length():
+    """A dart line from a boundary node through a row of nodes (the grid's line x = 0.5): the
+    walk records its start, goes on from node to node and the slit opens. Before, a walk that
+    started on a node left its start out, and the slit was refused as not starting on the
+    boundary (the Kratos cup's diagonal darts, docs/composites.md)."""
+    mesh = square(10)
+    dart = darts_from_polylines(mesh, [np.array([[0.5, 0.0, 0.0], [0.5, 0.6, 0.0]])])[0]
+    np.testing.assert_allclose(dart.points[0], [0.5, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(dart.points[-1], [0.5, 0.6, 0.0], atol=1e-12)
+    np.testing.assert_allclose(dart.points[:, 0], 0.5, atol=1e-12)
+    assert dart.length == pytest.approx(0.6, abs=1e-12)
+    slits = open_slits(mesh, [dart])
+    assert slits.mesh.num_points == mesh.num_points + 6  # a twin for every node but the tip
+    assert slits.mesh.area == pytest.approx(mesh.area, rel=1e-12)
+    # across the cells' diagonals, from node to node through their corners
+    slanted = darts_from_polylines(mesh, [np.array([[0.6, 0.0, 0.0], [0.1, 0.5, 0.0]])])[0]
+    np.testing.assert_allclose(slanted.points[0], [0.6, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(slanted.points.sum(axis=1), 0.6, atol=1e-12)  # on x + y = 0.6
+    assert slanted.length > 0.5  # to the last cell before its end (0.1, 0.5)
+    assert open_slits(mesh, [slanted]).mesh.area == pytest.approx(mesh.area, rel=1e-12)
+
+
 def test_a_walk_that_turns_back_stops_before_a_face_it_crossed():
     """A direction field that sends the walk back the way it came (a bisector whose sign flips
     from cell to cell) ends the line before it re-enters a face: without that check the walk

@@ -51,6 +51,8 @@ from .dart_options import DartOptions
 #: Cells at or beyond the locking angle belong to one region when cells whose smoothed shear is
 #: at least this fraction of it join them.
 JOIN_FRACTION = 0.9
+#: A given dart line is followed past the nearest of its next this many points (module docs).
+PROGRESS_WINDOW = 64
 #: Darts that leave the shear at or beyond the locking angle where more than this share of the
 #: area beyond it is negatively curved are answered with the advice to splice the ply.
 NEGATIVE_SHARE = 0.5
@@ -223,6 +225,10 @@ def darts_from_polylines(mesh: SurfaceMesh, polylines: Sequence[np.ndarray]) -> 
         targets = list(zip(faces[1:].tolist(), on_surface[1:], strict=True))
 
         def direction(cell: int, here: np.ndarray, _: np.ndarray | None, targets=targets):
+            if targets:  # progress: past the nearest of the next points (a walk through a node
+                # skips the cells around it, and a point left in one would turn the walk back)
+                ahead = np.array([p for _, p in targets[:PROGRESS_WINDOW]])
+                del targets[: int(np.argmin(np.linalg.norm(ahead - here, axis=1)))]
             while targets and (targets[0][0] == cell or np.allclose(targets[0][1], here)):
                 targets.pop(0)
             return None if not targets else targets[0][1] - here

@@ -48,8 +48,10 @@ def walk_line(
     ``direction`` returns None, before the mesh's boundary, or after ``max_length`` (mesh
     units), or before it would enter a face it has crossed already (a direction field that
     turns the walk back on itself: a slit must not cross itself). The line holds the start
-    (when it lies on an edge) and every edge crossing but one onto the boundary; where the walk
-    ends inside a face, its last crossing is the line's end.
+    (when it lies on an edge or is a node) and every edge crossing but one onto the boundary;
+    where the walk ends inside a face, its last crossing is the line's end. A walk that stands
+    on a node and whose step leaves its face at once goes on in the face of the node's fan the
+    step points into (the node is a point of the line).
     """
     triangles = check_triangles(mesh)
     points = mesh.points
@@ -63,9 +65,14 @@ def walk_line(
         a, b = triangles[face][(k + 1) % 3], triangles[face][(k + 2) % 3]
         ends.append((int(a), int(b)))
         fractions.append(float(w[(k + 2) % 3] / (w[(k + 1) % 3] + w[(k + 2) % 3])))
+    elif len(zero) == 2:  # the start is a node
+        node = int(triangles[face][int(np.argmax(w))])
+        ends.append((node, node))
+        fractions.append(0.0)
     last: np.ndarray | None = None
     length = 0.0
     visited = {int(face)}
+    fans: list[list[int]] | None = None  # the faces around every node, when first needed
     for _ in range(max_steps):
         corners = points[triangles[face]]
         here = w @ corners
@@ -89,6 +96,23 @@ def walk_line(
             exit_weights[(k + 2) % 3] / (exit_weights[(k + 1) % 3] + exit_weights[(k + 2) % 3])
         )
         following = int(neighbours[face, k])
+        at_node = _at_node(w, triangles[face])
+        if at_node is not None and reach[k] <= VERTEX_REACH:
+            # the walk stands on a node and its step leaves the face at once: go on in the face
+            # of the node's fan that the step points into (a line through a node would stop or
+            # turn back across the faces next to it)
+            if fans is None:
+                fans = _fans(triangles)
+            onward = _fan_face(at_node, here, step, fans, triangles, points, visited)
+            if onward is None:
+                break
+            if not ends or _node_of(ends[-1], fractions[-1]) != at_node:
+                ends.append((at_node, at_node))  # (unless the last crossing is the node)
+                fractions.append(0.0)
+            visited.add(onward)
+            face = onward
+            w = (triangles[onward] == at_node).astype(float)
+            continue
         if following < 0 or following in visited:
             break  # before the boundary, or before a face crossed already (turning back)
         ends.append((a, b))
@@ -102,6 +126,53 @@ def walk_line(
         w[int(np.flatnonzero(corners_next == b)[0])] = t
         face = following
     return SurfaceLine.at(points, np.array(ends, dtype=np.int64), np.array(fractions))
+
+
+#: A walk whose step from a node leaves its face within this fraction of the step is on the
+#: node (:func:`walk_line`).
+VERTEX_REACH = 1e-9
+
+
+def _at_node(w: np.ndarray, cell: np.ndarray) -> int | None:
+    """The node of ``cell`` the point of barycentric ``w`` stands on (within 1e-9), or None."""
+    k = int(np.argmax(w))
+    return int(cell[k]) if w[k] >= 1.0 - 1e-9 else None
+
+
+def _node_of(end: tuple[int, int], fraction: float) -> int | None:
+    """The node an edge position ``end`` (a, b) at ``fraction`` from a is on, or None."""
+    if end[0] == end[1] or fraction <= 1e-9:
+        return int(end[0])
+    return int(end[1]) if fraction >= 1.0 - 1e-9 else None
+
+
+def _fans(triangles: np.ndarray) -> list[list[int]]:
+    """The faces around every node."""
+    fans: list[list[int]] = [[] for _ in range(int(triangles.max()) + 1)]
+    for face, cell in enumerate(triangles.tolist()):
+        for node in cell:
+            fans[node].append(face)
+    return fans
+
+
+def _fan_face(node, here, step, fans, triangles, points, visited) -> int | None:
+    """The face around ``node`` not walked yet that the ``step`` from ``here`` (on the node)
+    points into (its projection onto the face between the face's two edges at the node), or
+    None."""
+    for face in fans[node]:
+        if face in visited:
+            continue
+        corners = points[triangles[face]]
+        normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+        normal /= np.linalg.norm(normal)
+        along = step - (step @ normal) * normal
+        if not np.linalg.norm(along) > 0:
+            continue
+        size = float(np.ptp(corners, axis=0).max())
+        probe = here + 1e-6 * size * along / np.linalg.norm(along)
+        if np.all(barycentric(probe, corners)[0] >= -1e-12):
+            return int(face)
+    return None
 
 
 @dataclass(frozen=True)
