@@ -118,7 +118,8 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
     if darted.needs_splices:
         parts.append(
             "<p class='warning'>Most of the area at or beyond the locking angle is negatively "
-            "curved: a dart takes out fabric the mould needs there. Splice the ply instead "
+            "curved: a dart takes out fabric the mould needs there. Draw darts that reach the "
+            "positively curved part beside it (<code>--dart-lines</code>), or splice the ply "
             "(<code>--splice-lines</code>).</p>"
         )
     if summary["darts"]:

@@ -434,6 +434,7 @@ def darts_verdict(darted) -> str:
         negative = summary["over_locking_curvature"]["negative"]
         verdict += (
             f"; {100 * negative:.0f} % of the area at or beyond it is negatively curved, where a "
-            "dart takes out fabric the mould needs: splice the ply there (--splice-lines)"
+            "dart takes out fabric the mould needs: draw darts that reach the positively curved "
+            "part beside it (--dart-lines), or splice the ply (--splice-lines)"
         )
     return verdict
