@@ -87,6 +87,9 @@ def test_a_kratos_membrane_model_reads_as_its_elements(tmp_path):
     assert len(corner) == 1  # node 20, after the gap in the ids
     assert mesh.area > 4.0 and mesh.area < 4.2
     assert {b.type for b in meshio.read(path).cells} == {"line3"}
+    tabs = path.with_name("tabs.mdpa")  # Kratos' GiD writes tabs between an element's numbers
+    tabs.write_text(MEMBRANE.replace("    1 1 10 11 14\n", "1\t1\t10\t11\t14\n"))
+    assert read_mesh(tabs).num_cells == 8
 
 
 def test_kratos_shell_quads_are_quads_and_solids_are_refused(tmp_path):
