@@ -120,16 +120,6 @@ class SplicedPly:
             out[self.cut.panel_ids == index] = np.asarray(result.fields[name])
         return out
 
-    def flat_coordinates(self) -> np.ndarray:
-        """Every node of ``cut.mesh`` in its piece's flat pattern ``(n, 2)`` (a node on a splice
-        line belongs to both pieces: it gets the last one's coordinates)."""
-        cells = self.cut.mesh.cells["triangle"]
-        out = np.full((self.cut.mesh.num_points, 2), np.nan)
-        for index, result in enumerate(self.results):
-            used = np.unique(cells[self.cut.panel_ids == index])
-            out[used] = result.material_coordinates
-        return out
-
     def summary(self) -> dict[str, Any]:
         """The numbers for a summary file: per piece its cells, area on the mould, largest shear,
         area at or beyond the locking angle, largest yarn strain of the cells and of the nodal

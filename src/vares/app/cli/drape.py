@@ -325,14 +325,12 @@ def _write_splices(folder, paths: list[Path], spliced, units: str, name: str) ->
     from ...io.dxf import CutPiece, write_dxf
     from ...io.meshes import write_surface
 
-    cut = spliced.cut
+    cut = spliced.cut  # the pieces' flat patterns are pieces.dxf's (they share the splices' nodes)
     fields = {
         "piece": cut.panel_ids.astype(float),
         "shear_angle": spliced.cell_field("shear_angle"),
     }
-    flat = spliced.flat_coordinates()
-    point_data = {"flat_u": flat[:, 0], "flat_v": flat[:, 1]}
-    write_surface(folder.staged(paths[0]), cut.mesh, None, fields, point_data)
+    write_surface(folder.staged(paths[0]), cut.mesh, None, fields)
     pieces = []
     for piece, result in zip(spliced.pieces, spliced.results, strict=True):
         largest = float(np.nanmax(np.abs(result.fields["shear_angle"])))
