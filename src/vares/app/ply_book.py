@@ -276,6 +276,19 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
     ]
 
 
+def _curvature_advice(darted) -> str:
+    """Where darts leave the shear at or beyond the locking angle on mostly negatively curved
+    surface (:attr:`~vares.analysis.darts.DartedPattern.needs_splices`), what relieves it."""
+    if not darted.needs_splices:
+        return ""
+    negative = darted.summary()["over_locking_curvature"]["negative"]
+    return (
+        f" {100 * negative:.0f} % of the area at or beyond the locking angle is negatively "
+        "curved, where a dart takes out fabric the mould needs: dart lines drawn to the "
+        "positively curved part beside it, or a splice, relieve it (docs/composites.md)."
+    )
+
+
 def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: str) -> list[str]:
     """The ply's darts: a table of their lengths and openings and the largest shear before and
     after; or, without darts, how much of the ply is at or beyond the locking angle."""
@@ -292,7 +305,7 @@ def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: 
             f"{after}: they do not lower it, so the ply is cut whole. {limit:.1f} % of the "
             "ply's area is at or beyond the locking angle."
         )
-        return [f"<p id='darts-{ident}'>{html.escape(text)}</p>"]
+        return [f"<p id='darts-{ident}'>{html.escape(text + _curvature_advice(darted))}</p>"]
     if darted is None or darted.after is None:
         if darted is None:
             why = "No darts (none asked for: darts = 'auto' or dart_lines)."
@@ -307,6 +320,8 @@ def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: 
             )
         extra = " (a dart or another seed or orientation is needed there)." if limit > 0 else "."
         text = f"{why} {limit:.1f} % of the ply's area is at or beyond the locking angle{extra}"
+        if darted is not None:
+            text += _curvature_advice(darted)
         return [f"<p id='darts-{ident}'>{html.escape(text)}</p>"]
     data = darted.summary()
     rows = [
