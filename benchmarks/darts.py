@@ -48,8 +48,9 @@ from pathlib import Path
 
 import numpy as np
 
-from vares.analysis.darts import smoothed, solve_with_darts
+from vares.analysis.darts import solve_with_darts
 from vares.analysis.drape import drape_ply
+from vares.analysis.splices import yarn_strain
 from vares.geometry.cutting import cut_mesh
 from vares.geometry.double_dome import side_darts
 from vares.geometry.examples import double_dome, double_dome_height, irregular_cap, rib30
@@ -303,7 +304,7 @@ def splice(cell_size: float, law: str, locking: float, along: str, picture: Path
     only)."""
     from vares.analysis.darts import over_locking_curvature
     from vares.analysis.drape_options import DrapeOptions
-    from vares.analysis.splices import drape_pieces, solve_with_splices, yarn_strain
+    from vares.analysis.splices import drape_pieces, solve_with_splices
     from vares.geometry.double_dome import axis_splice
 
     mesh, warp = mould("double-dome", 0, cell_size)
@@ -402,14 +403,7 @@ def quadrants(darted) -> None:
             shear[(np.sign(centres[:, 0]) == sx) & (np.sign(centres[:, 1]) == sy)].max()
             for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))
         ]
-        fields = result.fields
-        strain = np.maximum(
-            np.abs(fields["warp_stretch"] - 1.0), np.abs(fields["fill_stretch"] - 1.0)
-        )
-        mean = np.maximum(
-            np.abs(smoothed(result.mesh, fields["warp_stretch"] - 1.0)),
-            np.abs(smoothed(result.mesh, fields["fill_stretch"] - 1.0)),
-        )
+        strain, mean = yarn_strain(result), yarn_strain(result, nodal_mean=True)
         areas = result.mesh.cell_areas()
         beyond = areas[shear >= darted.locking_angle].sum() / areas.sum()
         shares = [100 * areas[strain > limit].sum() / areas.sum() for limit in (0.01, 0.02, 0.05)]

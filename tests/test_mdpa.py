@@ -108,6 +108,14 @@ def test_kratos_shell_quads_are_quads_and_solids_are_refused(tmp_path):
     )
     with pytest.raises(MeshError, match="TotalLagrangianElement3D4N is a solid element"):
         read_mesh(solid)
+    quadratic = path.with_name("quadratic.mdpa")
+    quadratic.write_text(
+        MEMBRANE.replace("MembraneElement3D3N", "MembraneElement3D6N").replace(
+            "    1 1 10 11 14\n", "    1 1 10 11 14 13 12 15\n"
+        )
+    )
+    with pytest.raises(MeshError, match="MembraneElement3D6N is a quadratic element"):
+        read_mesh(quadratic)
     broken = path.with_name("broken.mdpa")
     broken.write_text(MEMBRANE.replace("    8 1 14 20 17\n", "    8 1 14 21 17\n"))
     with pytest.raises(MeshError, match="refer to node 21"):

@@ -77,7 +77,8 @@ class SplicedPly:
     (``cut.mesh``, ``cut.panel_ids``: the piece of every cell, ``cut.lines``: the lines' node
     chains); ``pieces``: the pieces (named ``piece-1`` …, in the order of ``cut.panel_ids``) and
     ``results`` their patterns; ``locking_angle`` in degrees; ``seconds``: the pieces' solves;
-    ``nets``: the kinematic drape of every piece (:func:`drape_pieces`), or None.
+    ``nets``: the kinematic drape of every piece (:func:`drape_pieces`), or None;
+    ``net_errors``: why a piece has no net (None where it has one).
     """
 
     before: PatternResult
@@ -86,7 +87,8 @@ class SplicedPly:
     results: list[PatternResult]
     locking_angle: float
     seconds: float
-    nets: list[PlyDrape] | None = None
+    nets: list[PlyDrape | None] | None = None
+    net_errors: list[str | None] | None = None
 
     @property
     def splice_lines(self) -> list[np.ndarray]:
@@ -129,7 +131,8 @@ class SplicedPly:
         lengths; the largest shear before and after."""
         pieces = []
         nets = self.nets or [None] * len(self.pieces)
-        for piece, result, net in zip(self.pieces, self.results, nets, strict=True):
+        errors = self.net_errors or [None] * len(self.pieces)
+        for piece, result, net, error in zip(self.pieces, self.results, nets, errors, strict=True):
             shear = np.abs(np.nan_to_num(result.fields["shear_angle"]))
             area = result.mesh.cell_areas()
             strain, mean = yarn_strain(result), yarn_strain(result, nodal_mean=True)
@@ -154,6 +157,8 @@ class SplicedPly:
                     "max_shear": float(net.producibility.max_shear),
                     "limit_fraction": float(net.producibility.fractions["limit"]),
                 }
+            elif error is not None:
+                pieces[-1]["kinematic"] = {"error": error}
         return {
             "locking_angle": self.locking_angle,
             "max_shear_before": self.max_shear_before,
@@ -216,10 +221,20 @@ def drape_pieces(
     """``spliced`` with the kinematic drape of every piece (:func:`vares.analysis.drape.drape_ply`
     with ``options``, the warp ``warp_direction`` unless the options name one, each piece from
     its own node nearest its nodes' centroid): the industry's reference beside the pieces'
-    patterns."""
+    patterns. A piece whose net cannot be made (a seed where the warp runs along the normal)
+    gets None and the reason (:attr:`SplicedPly.net_errors`): the net is beside the pattern."""
+    from ..geometry.drape_net import DrapeError
     from .drape import drape_ply
 
     own = options.replace(seed=None)
     warp = tuple(float(v) for v in warp_direction)
-    nets = [drape_ply(piece.mesh, own, warp_direction=warp) for piece in spliced.pieces]
-    return dataclasses.replace(spliced, nets=nets)
+    nets: list[PlyDrape | None] = []
+    errors: list[str | None] = []
+    for piece in spliced.pieces:
+        try:
+            nets.append(drape_ply(piece.mesh, own, warp_direction=warp))
+            errors.append(None)
+        except DrapeError as exc:
+            nets.append(None)
+            errors.append(f"no net: {exc}")
+    return dataclasses.replace(spliced, nets=nets, net_errors=errors)

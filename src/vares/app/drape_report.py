@@ -17,7 +17,13 @@ if TYPE_CHECKING:
     from ..analysis.drape import PlyDrape
     from ..analysis.splices import SplicedPly
 
-__all__ = ["darts_section", "drape_page", "drape_section", "splices_section"]
+__all__ = [
+    "darts_section",
+    "drape_page",
+    "drape_section",
+    "splice_piece_rows",
+    "splices_section",
+]
 
 
 def _ply_rows(ply: PlyDrape, units: str) -> list[tuple[str, object]]:
@@ -167,29 +173,7 @@ def splices_section(spliced: SplicedPly, units: str) -> list[str]:
         ),
         ("pattern of the whole ply", _state(spliced.before)),
     ]
-    pieces = [
-        (
-            p["name"],
-            p["cells"],
-            f"{number(p['area'], 6)} {units}²",
-            f"{number(p['max_shear'], 4)}°",
-            _strains(p),
-            p["iterations"],
-            "yes" if p["converged"] else "no",
-            f"{number(p['kinematic']['max_shear'], 4)}°" if "kinematic" in p else "",
-        )
-        for p in summary["pieces"]
-    ]
-    header = (
-        "piece",
-        "cells",
-        "area",
-        "largest shear",
-        "largest yarn strain (nodal mean)",
-        "iterations",
-        "converged",
-        "net's largest shear",
-    )
+    header, pieces = splice_piece_rows(summary, units)
     parts = [
         "<h2>Splices</h2>",
         table(rows, ident="splices"),
@@ -202,11 +186,37 @@ def splices_section(spliced: SplicedPly, units: str) -> list[str]:
     return parts
 
 
-def _strains(piece: dict) -> str:
-    if piece["max_yarn_strain"] is None:
-        return ""
-    cells, mean = piece["max_yarn_strain"], piece["max_yarn_strain_nodal_mean"]
-    return f"{100 * cells:.2f} % ({100 * mean:.2f} %)"
+def splice_piece_rows(summary: dict, units: str) -> tuple[tuple[str, ...], list[tuple[str, ...]]]:
+    """The header and one row per piece of a spliced ply's ``summary``
+    (:meth:`~vares.analysis.splices.SplicedPly.summary`), as the report and ``vares drape``
+    print them."""
+    header = (
+        "piece",
+        "cells",
+        f"area ({units}²)",
+        "largest shear",
+        "largest yarn strain (nodal mean)",
+        "iterations",
+        "converged",
+        "net's largest shear",
+    )
+    rows = []
+    for p in summary["pieces"]:
+        strain, mean = p["max_yarn_strain"], p["max_yarn_strain_nodal_mean"]
+        net = p.get("kinematic", {})
+        rows.append(
+            (
+                p["name"],
+                str(p["cells"]),
+                number(p["area"], 6),
+                f"{number(p['max_shear'], 4)}°",
+                "" if strain is None else f"{100 * strain:.2f} % ({100 * mean:.2f} %)",
+                str(p["iterations"]),
+                "yes" if p["converged"] else "NO",
+                f"{number(net['max_shear'], 4)}°" if "max_shear" in net else net.get("error", ""),
+            )
+        )
+    return header, rows
 
 
 def _state(result) -> str:

@@ -4,7 +4,7 @@ At an interior node the **angle defect** ``2π − Σ θ`` (the corner angles of
 integral of the Gauss curvature ``K`` over the node's share of the surface (Gauss–Bonnet); divided
 by a third of the area of its triangles it is ``K`` there. A boundary node has no defect of its own
 (the boundary's turning is geodesic curvature, not ``K``): a cell takes the mean ``K`` of its
-interior corners, and a cell with none takes that of its interior neighbours' corners.
+interior corners, and a cell with none takes that of the cells around its corners.
 
 Why the sign matters to a ply. A fabric whose yarns keep their length covers a positively curved
 region (a dome, ``K > 0``) only by shearing in more fabric than the region's area holds at its
@@ -45,21 +45,26 @@ def angle_defects(mesh: SurfaceMesh) -> tuple[np.ndarray, np.ndarray]:
     total = np.bincount(triangles.ravel(), angles.ravel(), minlength=n)
     area = np.repeat(mesh.cell_areas() / 3.0, 3)
     share = np.bincount(triangles.ravel(), area, minlength=n)
-    defect = 2.0 * np.pi - total
-    defect[np.unique(mesh.boundary_edges())] = 0.0
+    defect = np.where(_interior(mesh), 2.0 * np.pi - total, 0.0)
     return defect, share
+
+
+def _interior(mesh: SurfaceMesh) -> np.ndarray:
+    """Whether each node ``(n,)`` is off the boundary."""
+    interior = np.ones(mesh.num_points, dtype=bool)
+    interior[np.unique(mesh.boundary_edges())] = False
+    return interior
 
 
 def cell_gauss_curvature(mesh: SurfaceMesh) -> np.ndarray:
     """The Gauss curvature ``K`` of every triangle of the triangulated ``mesh`` ``(m,)`` (1 /
     mesh units²; module docs): the mean of its interior corners' angle defect per area, or, for a
-    cell with no interior corner, the mean over the interior corners of the cells it shares a node
-    with (NaN where there are none)."""
+    cell with no interior corner, the mean of the interior-corner values of the cells around its
+    corners (each counted once per corner it shares; NaN where there are none)."""
     mesh = triangulated(mesh)
     triangles = mesh.cells["triangle"]
     defect, share = angle_defects(mesh)
-    interior = np.ones(mesh.num_points, dtype=bool)
-    interior[np.unique(mesh.boundary_edges())] = False
+    interior = _interior(mesh)
     nodal = np.where(interior, defect / np.where(share > 0, share, 1.0), 0.0)
     counted = interior[triangles]
     count = counted.sum(axis=1)

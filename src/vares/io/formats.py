@@ -225,13 +225,12 @@ def read_mdpa(path: Path) -> PolygonSoup:
             points.append(values[1:])
         elif block == "Elements":
             ids = _numbers(tokens, path, number, int)[2:]
-            solid = len(ids) > 4 or (
-                len(ids) == 4 and not any(k in name.lower() for k in _MDPA_SURFACES)
-            )
-            if solid:
+            surface = any(k in name.lower() for k in _MDPA_SURFACES)
+            if len(ids) > 4 or (len(ids) == 4 and not surface):
+                kind = "a quadratic element" if surface else "a solid element"
                 raise MeshError(
-                    f"{path}, line {number}: {name} is a solid element ({len(ids)} nodes); "
-                    "vares needs the surface (membrane or shell elements)"
+                    f"{path}, line {number}: {name} is {kind} ({len(ids)} nodes); vares reads "
+                    "the 3- and 4-node surface elements of a membrane or shell model"
                 )
             if len(ids) >= 3 and "line" not in name.lower():
                 faces.append(ids)

@@ -185,6 +185,7 @@ def drape(
         if values["report"]:
             paths.append(output / "drape.html")
         inputs = [] if surface is None else [surface]
+        inputs += [Path(f) for f in (darting.dart_lines, darting.splice_lines) if f is not None]
         folder = OutputFolder(output, paths, force=values["force"], inputs=inputs, command="drape")
         folder.check()
         ply = drape_ply(mesh, options)
@@ -346,30 +347,12 @@ def _write_splices(folder, paths: list[Path], spliced, units: str, name: str) ->
 def _show_splices(spliced, units: str) -> None:
     from rich.table import Table
 
-    summary = spliced.summary()
-    table = Table(
-        "piece",
-        "cells",
-        f"area ({units}²)",
-        "largest shear",
-        "largest yarn strain (nodal mean)",
-        "iterations",
-        "converged",
-        "net's largest shear",
-        title=f"splices (locking {spliced.locking_angle:g}°)",
-    )
-    for piece in summary["pieces"]:
-        strain, mean = piece["max_yarn_strain"], piece["max_yarn_strain_nodal_mean"]
-        table.add_row(
-            piece["name"],
-            str(piece["cells"]),
-            f"{piece['area']:.6g}",
-            f"{piece['max_shear']:.2f}°",
-            "" if strain is None else f"{100 * strain:.2f} % ({100 * mean:.2f} %)",
-            str(piece["iterations"]),
-            "yes" if piece["converged"] else "NO",
-            f"{piece['kinematic']['max_shear']:.2f}°" if "kinematic" in piece else "",
-        )
+    from ..drape_report import splice_piece_rows
+
+    header, rows = splice_piece_rows(spliced.summary(), units)
+    table = Table(*header, title=f"splices (locking {spliced.locking_angle:g}°)")
+    for row in rows:
+        table.add_row(*row)
     console.print(table)
     console.print(splices_verdict(spliced))
 
