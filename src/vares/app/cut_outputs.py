@@ -66,6 +66,10 @@ def cutting_details(outcome: JobOutcome) -> dict:
         "refined_cells": plan.refined_cells,
         "replaced_geodesics": plan.replaced_geodesics,
         "interlock": plan.interlock,
+        "cross_seams": {
+            "strips_cut": plan.cross_cut,
+            "pieces_each": plan.pieces if plan.cross_cut else 1,
+        },
         "roll_estimates": {
             kind: {"strips": strips, "length": length}
             for kind, (strips, length) in plan.compared.items()

@@ -1,6 +1,8 @@
-"""Cutting a panel of a cut mesh in two along a line across it: a cross seam."""
+"""Cutting panels of a cut mesh across, along lines from seam to seam: cross seams."""
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -10,13 +12,17 @@ from .surface_lines import CuttingError, SurfaceLine
 __all__ = ["cut_across"]
 
 
-def cut_across(cut: CutMesh, line: SurfaceLine, snap: float = SNAP) -> CutMesh:
-    """``cut`` cut further along ``line`` (on ``cut.mesh``, its ends on nodes of seams or of
-    the boundary): the panel it crosses becomes two. The new chain is the last of ``lines``;
-    the panels keep their order, the second part of the one split comes right after it."""
+def cut_across(
+    cut: CutMesh, lines: SurfaceLine | Sequence[SurfaceLine], snap: float = SNAP
+) -> CutMesh:
+    """``cut`` cut further along ``lines`` (one line or several; on ``cut.mesh``, each from a
+    node of a seam or of the boundary to another, none crossing another): every line splits
+    the panel it crosses in two. The new chains follow ``cut.lines``; the panels keep their
+    order, the parts of one that was split come right after it (by their first cell)."""
     from .surface_points import FaceLocator
 
-    further = cut_mesh(cut.mesh, [line], snap, panels=False)
+    lines = [lines] if isinstance(lines, SurfaceLine) else list(lines)
+    further = cut_mesh(cut.mesh, lines, snap, panels=False)
     cells = further.mesh.cells["triangle"]
     seam_edges = np.unique(np.sort(np.vstack([cut.seam_edges, further.seam_edges]), axis=1), axis=0)
     regions = panel_regions(cells, seam_edges, further.mesh.num_points)
@@ -26,9 +32,10 @@ def cut_across(cut: CutMesh, line: SurfaceLine, snap: float = SNAP) -> CutMesh:
     for region in range(int(regions.max()) + 1):
         mine = np.flatnonzero(regions == region)
         order.append((int(np.bincount(before[mine]).argmax()), int(mine[0]), region))
-    if len(order) != cut.num_panels + 1:
+    if len(order) != cut.num_panels + len(lines):
+        split = "a line across a panel" if len(lines) == 1 else f"{len(lines)} lines across panels"
         raise CuttingError(
-            f"a line across a panel must split one panel in two; it left {len(order)} panels "
+            f"{split} must split {len(lines)} panel(s) in two; they left {len(order)} panels "
             f"of {cut.num_panels}"
         )
     renumber = np.empty(len(order), dtype=np.int64)
@@ -37,7 +44,7 @@ def cut_across(cut: CutMesh, line: SurfaceLine, snap: float = SNAP) -> CutMesh:
     return CutMesh(
         further.mesh,
         renumber[regions],
-        [*cut.lines, further.lines[0]],
+        [*cut.lines, *further.lines],
         seam_edges,
         min(cut.worst_angle, further.worst_angle),
         cut.input_worst_angle,

@@ -130,6 +130,13 @@ class CutResult:
                 "the strips lie one after the other: planned in pairs, head to tail, they could "
                 f"not be ({plan.pairs_refused})"
             )
+        if plan.cross_cut:
+            strips = len(set(plan.strip_of))
+            notes.append(
+                f"{plan.cross_cut} of {strips} strips are cut across into {plan.pieces} pieces "
+                "each (cross seams, matched like every seam; each piece's warp along its own "
+                "length): whole, no number of strips fits the roll, as their flattened strips bow"
+            )
         if plan.split is not None:
             a, b = (plan.panels[k].name for k in plan.split)
             notes.append(
@@ -388,6 +395,7 @@ def _plan(
             warp_direction=options.warp_direction,
             snap=cutting.snap,
             interlock=interlock,
+            cross_seams=cutting.cross_seams == "auto",
         )
 
     return split_lone_strip(choose_plan(planned, cutting.interlock, earlier))

@@ -25,7 +25,7 @@ import numpy as np
 from ..geometry.surface_lines import CuttingError
 from .strip_plan import StripPlan
 
-__all__ = ["least_count"]
+__all__ = ["NoFitError", "NotNarrowerError", "least_count"]
 
 #: Equalising evaluations per number of gaps, and the width ratio that is equal enough.
 _EQUALISE, _EQUAL = 6, 1.005
@@ -41,6 +41,21 @@ _EVEN = 1.03
 _NOISE = 1.01
 #: Twice the gaps (or more) and still this fraction of their mean width: more will not fit.
 _NARROWER = 0.8
+
+
+class NoFitError(CuttingError):
+    """No number of strips fits the roll (they do not get narrower with their number, or more
+    than the most strips allowed would be needed)."""
+
+
+class NotNarrowerError(NoFitError):
+    """Strips that do not get narrower with their number; ``mean`` is the mean gap width of the
+    most gaps tried."""
+
+    def __init__(self, message: str, mean: float) -> None:
+        super().__init__(message)
+        self.mean = mean
+
 
 #: A layout of gaps of the given parameter spans, and the width of each gap.
 Evaluate = Callable[[np.ndarray], tuple[StripPlan, np.ndarray]]
@@ -114,7 +129,7 @@ def _narrowing(tried: dict[int, _Count], count: int, width: float, interlock: bo
     for fewer, trial in tried.items():
         if 2 * fewer <= count and trial.widest > width and mean > _NARROWER * trial.widths.mean():
             kind = "strips in pairs" if interlock else "strips"
-            raise CuttingError(
+            raise NotNarrowerError(
                 f"{kind} do not get narrower with their number: {fewer} gaps between cutting "
                 f"lines are {trial.widths.mean():.4g} wide on average, {count} gaps "
                 f"{mean:.4g} (strips at most {width:g} wide)"
@@ -122,7 +137,8 @@ def _narrowing(tried: dict[int, _Count], count: int, width: float, interlock: bo
                     ": plan them one after the other (interlock never)"
                     if interlock
                     else ": their flattened strips bow; try another strip direction or layout"
-                )
+                ),
+                mean,
             )
 
 
@@ -143,7 +159,7 @@ def least_count(
     spans = np.full(count, total / count)
     while count not in tried:
         if count > max_strips:
-            raise CuttingError(f"more than {max_strips} strips would be needed")
+            raise NoFitError(f"more than {max_strips} strips would be needed")
         tried[count] = trial = _Count()
         trial.equalise(evaluate, spans, total, width, polish=False)
         fits = trial.widest <= width
@@ -159,7 +175,7 @@ def least_count(
     best = min((c for c, t in tried.items() if t.widest <= width), default=None)
     if best is None:
         fit = "two side by side, each about half of it" if interlock else "one"
-        raise CuttingError(
+        raise NoFitError(
             f"no layout of up to {max(tried)} strips fits the roll width {width:g} ({fit})"
         )
     spent = sum(t.evaluations for t in tried.values())

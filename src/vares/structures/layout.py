@@ -31,6 +31,7 @@ side by side (:mod:`.widths`; when to, :mod:`.pairing`).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Sequence
@@ -42,9 +43,10 @@ from ..geometry.line_families import LineFamily, geodesic_between_ends, line_fam
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.refine import refine
 from ..geometry.surface_lines import CuttingError, SurfaceLine, triangulated
-from .equalise import least_count
-from .panels import Panel, split_panels
-from .strip_plan import StripPlan
+from .cross_seams import MAX_PIECES, split_across
+from .equalise import NoFitError, NotNarrowerError, least_count
+from .panels import split_panels
+from .strip_plan import StripPlan, along_strips
 from .widths import pattern_direction, strip_widths
 
 __all__ = [
@@ -69,6 +71,9 @@ MAX_REFINED_CELLS = 2_000_000
 APART = 0.2
 #: Pieces of a plane section shorter than this fraction of the roll width are no cutting lines.
 _SHORTEST = 0.1
+#: Strips cut across into one piece more whose gaps are at least this fraction of their mean
+#: width before are not cut into more (:func:`_in_pieces`).
+_NARROWER_PIECES = 0.95
 #: Further refinements at most, when planned lines meet, before plane sections replace geodesics.
 _RETRIES = 2
 
@@ -86,6 +91,7 @@ def plan_strips(
     snap: float = SNAP,
     max_strips: int = 200,
     interlock: bool = False,
+    cross_seams: bool = True,
 ) -> StripPlan:
     """The least number of equally wide strips whose flattened width, with a seam allowance on
     each seam side and ``edge_allowance`` on a side along the surface's boundary, is at most
@@ -93,7 +99,10 @@ def plan_strips(
     the direction along each strip. The surface is refined on its own faces where its cells are
     too large for strips of ``width``. With ``interlock`` the strips are planned to lie in
     pairs, head to tail: the warp runs along one seam of each (the same side of every strip,
-    unless ``warp_direction`` is given) and two of them must fit ``width`` side by side."""
+    unless ``warp_direction`` is given) and two of them must fit ``width`` side by side.
+    With ``cross_seams``, where strips alone fit no roll of ``width`` whole, however many, the
+    strips too wide are cut across into pieces (:mod:`.cross_seams`): as few pieces a strip as
+    let some number of strips fit."""
     if seams not in SEAM_KINDS:
         raise CuttingError(f"seams must be one of {', '.join(SEAM_KINDS)}; got {seams!r}")
     if not width > 0:
@@ -118,22 +127,50 @@ def plan_strips(
         )
     refined = _Refined(surface, width, longest, strips)
 
-    def evaluate(spans: np.ndarray) -> tuple[StripPlan, np.ndarray]:
+    def evaluate(spans: np.ndarray, pieces: int = 1) -> tuple[StripPlan, np.ndarray]:
         plan = refined.layout(family, spans, seams, snap, warp_direction)
         if interlock and warp_direction is None:
-            plan.warps = _along_strips(plan.cut, plan.panels, family, one_seam=True)
+            plan.warps = along_strips(plan.cut, plan.panels, family, one_seam=True)
             plan.straight_warp = True
         plan.interlock = interlock
         plan.widths = strip_widths(plan, family, seam_allowance, edge_allowance)
+        if pieces > 1:
+            plan = split_across(plan, width, pieces, snap)
+            plan.widths = strip_widths(plan, family, seam_allowance, edge_allowance)
         plan.input_cells = input_cells
         return plan, _gap_widths(plan, family, spans)
 
     smallest = 2 if family.closed else 1
     first, _ = evaluate(np.full(8, total / 8) if family.closed else np.array([total]))
     count = max(smallest, math.ceil(sum(first.widths) / width))
-    plan = least_count(evaluate, total, count, smallest, width, max_strips, interlock)
+    try:
+        plan = least_count(evaluate, total, count, smallest, width, max_strips, interlock)
+    except NotNarrowerError as whole:
+        if interlock or not cross_seams:
+            raise
+        plan = _in_pieces(evaluate, whole, total, count, smallest, width, max_strips)
     plan.evaluations += 1
     return plan
+
+
+def _in_pieces(evaluate, whole: NotNarrowerError, total, count, smallest, width, max_strips):
+    """The plan of :func:`plan_strips` with the strips too wide cut across into the fewest
+    pieces (2 … ``MAX_PIECES``) for which some number of strips fits ``width``; ``whole`` is
+    the refusal of whole strips. Refused where one piece more does not make the gaps narrower
+    on average (the strips are wide, not bowed), or more strips than ``max_strips`` would be
+    needed."""
+    mean = whole.mean
+    for pieces in range(2, MAX_PIECES + 1):
+        try:
+            return least_count(
+                functools.partial(evaluate, pieces=pieces),
+                total, count, smallest, width, max_strips, False,
+            )  # fmt: skip
+        except NotNarrowerError as refused:
+            if refused.mean >= _NARROWER_PIECES * mean:
+                break
+            mean = refused.mean
+    raise NoFitError(f"{whole}; cut across into {pieces} pieces they do not fit either") from None
 
 
 def longest_edge_for(width: float, interlock: bool = False) -> float:
@@ -350,41 +387,5 @@ def strips_along_lines(
         warp = np.asarray(warp_direction, dtype=float)
         warps = [warp / np.linalg.norm(warp)] * len(panels)
     else:
-        warps = _along_strips(cut, panels, family)
+        warps = along_strips(cut, panels, family)
     return StripPlan(cut, panels, list(lines), warps, [], family)
-
-
-def _along_strips(
-    cut: CutMesh, panels: list[Panel], family, one_seam: bool = False
-) -> list[np.ndarray]:
-    """Per panel: the sum of its seam segments (lines oriented alike), normalised; with
-    ``one_seam``, of one seam only, on the same side of every strip."""
-    points, cells = cut.mesh.points, cut.mesh.cells["triangle"]
-    n = len(points)
-    sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2)
-    owner = np.repeat(cut.panel_ids, 3)
-    keys = sides[:, 0] * n + sides[:, 1]
-    lookup = dict(zip(keys.tolist(), owner.tolist(), strict=True))
-    by_side = np.zeros((2, len(panels), 3))  # the seams a strip lies left of, and right of
-    for chain in cut.lines:
-        for u, w in itertools.pairwise(chain):
-            vector = points[w] - points[u]
-            for side, key in enumerate((u * n + w, w * n + u)):
-                if key in lookup:
-                    by_side[side, lookup[key]] += vector
-    sums = by_side.sum(axis=0)
-    if one_seam:  # the seam on the strip's right (looking along it), where it has one
-        right = np.linalg.norm(by_side[0], axis=1)[:, None] > 0
-        sums = np.where(right, by_side[0], by_side[1])
-    out = []
-    for index, panel in enumerate(panels):
-        length = np.linalg.norm(sums[index])
-        if length > 0:
-            out.append(sums[index] / length)
-        elif family is not None:
-            out.append(family.warp(panel.mesh.points))
-        else:
-            from ..geometry.flatten import projection_plane
-
-            out.append(projection_plane(panel.mesh).axes[0])
-    return out

@@ -9,7 +9,7 @@ from ..geometry.cutting import SNAP
 from ..geometry.line_families import LAYOUTS
 from ..options import Options, OptionsError, option
 
-__all__ = ["EDGE_TYPES", "INTERLOCK", "SEAM_LINES", "CutOptions", "StructureOptions"]
+__all__ = ["CROSS_SEAMS", "EDGE_TYPES", "INTERLOCK", "SEAM_LINES", "CutOptions", "StructureOptions"]
 
 #: Kinds of cutting lines: computed, or the user's curves.
 SEAM_LINES = ("geodesic", "planar", "curves")
@@ -17,6 +17,7 @@ SEAM_LINES = ("geodesic", "planar", "curves")
 EDGE_TYPES = ("free", "cable", "clamp")
 #: Whether strips are planned to lie in pairs on the roll (``auto``: where that saves roll).
 INTERLOCK = ("auto", "always", "never")
+CROSS_SEAMS = ("auto", "never")
 
 
 @dataclass(frozen=True)
@@ -120,6 +121,14 @@ class CutOptions(Options):
         "of each: auto (where that saves at least a tenth of the roll), always or never.",
         section="cut",
         choices=INTERLOCK,
+    )
+    cross_seams: str = option(
+        "auto",
+        "str",
+        "Cut strips across into pieces, each with its warp along it, where whole strips fit no "
+        "roll of this width however many there are (their flattened strips bow): auto or never.",
+        section="cut",
+        choices=CROSS_SEAMS,
     )
     allow_turn: bool = option(
         True,

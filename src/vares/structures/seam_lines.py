@@ -24,6 +24,10 @@ class SeamLine:
     length_2d: tuple[float, float]
 
 
+def _midpoints(polyline: np.ndarray) -> np.ndarray:
+    return 0.5 * (polyline[:-1] + polyline[1:])
+
+
 def _stretch(polyline: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
     """Length of a polyline between the points nearest to ``start`` and ``end`` (the stretch of
     a cutting line a seam follows: its ends may have been moved onto boundary nodes)."""
@@ -45,18 +49,20 @@ def seam_lines(plan: StripPlan, structure: StructureResult) -> list[SeamLine]:
     pattern lengths on both sides."""
     from scipy.spatial import cKDTree
 
-    chains = [plan.cut.mesh.points[c] for c in plan.cut.lines]
+    # a seam's edges are edges of the chain it follows: their midpoints find it (its end nodes
+    # are also on the chains it meets, a cross seam's on the seams at its ends)
+    middles = [_midpoints(plan.cut.mesh.points[c]) for c in plan.cut.lines]
     tree = owner = None  # one strip: no cutting line to follow
-    if chains:
-        owner = np.concatenate([np.full(len(c), k) for k, c in enumerate(chains)])
-        tree = cKDTree(np.vstack(chains))
+    if any(len(m) for m in middles):
+        owner = np.concatenate([np.full(len(m), k) for k, m in enumerate(middles)])
+        tree = cKDTree(np.vstack(middles))
     out = []
     for seam, report in zip(structure.seams, structure.seam_reports, strict=True):
         nodes = structure.panels[seam.first].mesh.points[seam.nodes_first]
         length_3d = float(np.linalg.norm(np.diff(nodes, axis=0), axis=1).sum())
         line_length = float("nan")
         if tree is not None:
-            _, found = tree.query(nodes)
+            _, found = tree.query(_midpoints(nodes))
             line = int(np.bincount(owner[found]).argmax())
             if line < len(plan.lines):
                 line_length = _stretch(plan.lines[line].points, nodes[0], nodes[-1])

@@ -4,6 +4,7 @@ its panels, the cutting lines and what the planning tried. Its own module so tha
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -13,7 +14,7 @@ from ..geometry.line_families import LineFamily
 from ..geometry.surface_lines import SurfaceLine
 from .panels import Panel
 
-__all__ = ["StripPlan"]
+__all__ = ["StripPlan", "along_strips"]
 
 
 @dataclass
@@ -33,6 +34,10 @@ class StripPlan:
     pairs would need with one seam along the warp, ``compared`` the roll estimates of both
     plans (:mod:`.pairing`), ``pairs_refused`` why strips planned alone could not be planned in
     pairs (where that was tried) and ``split`` the two halves of a strip cut across, if any.
+    Where strips too wide for the roll were cut across into pieces (:mod:`.cross_seams`),
+    ``panels`` are the pieces, ``strip_of`` gives the strip of each (indices of the strips
+    before the cut; empty where none was cut), ``pieces`` the parts each strip cut was cut into
+    and ``cross_cut`` the number of strips cut.
     """
 
     cut: CutMesh
@@ -54,3 +59,42 @@ class StripPlan:
     split: tuple[int, int] | None = None
     pairs_refused: str = ""
     straight_warp: bool = False
+    strip_of: list[int] = field(default_factory=list)
+    pieces: int = 1
+    cross_cut: int = 0
+
+
+def along_strips(
+    cut: CutMesh, panels: list[Panel], family, one_seam: bool = False
+) -> list[np.ndarray]:
+    """Per panel: the sum of its seam segments (lines oriented alike), normalised; with
+    ``one_seam``, of one seam only, on the same side of every strip."""
+    points, cells = cut.mesh.points, cut.mesh.cells["triangle"]
+    n = len(points)
+    sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2)
+    owner = np.repeat(cut.panel_ids, 3)
+    keys = sides[:, 0] * n + sides[:, 1]
+    lookup = dict(zip(keys.tolist(), owner.tolist(), strict=True))
+    by_side = np.zeros((2, len(panels), 3))  # the seams a strip lies left of, and right of
+    for chain in cut.lines:
+        for u, w in itertools.pairwise(chain):
+            vector = points[w] - points[u]
+            for side, key in enumerate((u * n + w, w * n + u)):
+                if key in lookup:
+                    by_side[side, lookup[key]] += vector
+    sums = by_side.sum(axis=0)
+    if one_seam:  # the seam on the strip's right (looking along it), where it has one
+        right = np.linalg.norm(by_side[0], axis=1)[:, None] > 0
+        sums = np.where(right, by_side[0], by_side[1])
+    out = []
+    for index, panel in enumerate(panels):
+        length = np.linalg.norm(sums[index])
+        if length > 0:
+            out.append(sums[index] / length)
+        elif family is not None:
+            out.append(family.warp(panel.mesh.points))
+        else:
+            from ..geometry.flatten import projection_plane
+
+            out.append(projection_plane(panel.mesh).axes[0])
+    return out

@@ -156,7 +156,8 @@ def strip_widths(
     ``plan.lengths`` (extents along the warp) and ``plan.straight_pairs`` (:func:`pair_width`
     with ``straight``, allowances included), mesh units."""
     out, plan.lengths, plan.straight_pairs = [], [], []
-    last = len(plan.panels) - 1
+    strips = plan.strip_of or list(range(len(plan.panels)))  # pieces of strips cut across
+    last = max(strips, default=0)
     for index, (panel, warp) in enumerate(zip(plan.panels, plan.warps, strict=True)):
         flat = lscm(panel.mesh)
         if plan.interlock and plan.straight_warp:
@@ -165,7 +166,7 @@ def strip_widths(
             along = pattern_direction(panel.mesh, flat, warp)
         ring = flat[panel.mesh.boundary_loops()[0]]
         plan.lengths.append(float(np.ptp(flat @ along)))
-        outer = family is not None and not family.closed and index in (0, last)
+        outer = family is not None and not family.closed and strips[index] in (0, last)
         sides = 2 if last == 0 else 1
         allowance = (
             sides * edge_allowance + (2 - sides) * seam_allowance if outer else 2 * seam_allowance

@@ -234,8 +234,13 @@ def _show_cut(outcome: JobOutcome) -> None:
         if result.options.seams == "curves"
         else f"of {result.options.seams} lines ({plan.evaluations} layouts tried)"
     )
+    pieces = (
+        f"{len(plan.panels)} pieces of {len(set(plan.strip_of))} strips"
+        if plan.cross_cut
+        else f"{len(plan.panels)} strips"
+    )
     console.print(
-        f"cut: {len(plan.panels)} strips {lines}, widest {max(result.widths):.4g} {units} with "
+        f"cut: {pieces} {lines}, widest {max(result.widths):.4g} {units} with "
         f"allowances (roll {result.options.roll_width:g}); worst cell angle "
         f"{plan.cut.worst_angle:.1f}° (surface {result.surface_worst_angle:.1f}°); area 3D "
         f"{result.panel_area:.6g} of {result.surface_area:.6g} {units}²"
