@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..geometry.cutting import CutMesh, cut_mesh
+from ..geometry.cutting import CutMesh, LinesMeetError, cut_mesh
 from ..geometry.drawn_lines import curves_on_surface
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.surface_lines import CuttingError, triangulated
@@ -198,8 +198,7 @@ def solve_with_splices(
     if not len(polylines):
         raise CuttingError("splices need at least one splice line")
     surface = triangulated(mesh)
-    drawn, lines = curves_on_surface(surface, [np.asarray(p, dtype=float) for p in polylines], snap)
-    cut = cut_mesh(drawn, lines, snap)
+    cut = cut_along(surface, [np.asarray(p, dtype=float) for p in polylines], snap)
     if cut.num_panels < 2:
         raise CuttingError(
             "the splice lines do not cut the mould into pieces: draw each from the boundary "
@@ -213,6 +212,97 @@ def solve_with_splices(
     results = [solve(piece.mesh, material, thickness, **settings) for piece in pieces]
     seconds = time.perf_counter() - clock
     return SplicedPly(before, cut, pieces, results, float(locking_angle), seconds)
+
+
+def cut_along(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap: float) -> CutMesh:
+    """The triangle mesh ``surface`` cut along ``polylines`` (``(k, 3)`` each, from the boundary
+    to the boundary): all at once where no two of them meet; else one after the other, each
+    piece by piece (:func:`_piece_by_piece`), so that a line ends on the lines it crosses."""
+    drawn, lines = curves_on_surface(surface, polylines, snap)
+    try:
+        return cut_mesh(drawn, lines, snap)
+    except LinesMeetError:
+        if len(polylines) < 2:
+            raise
+    return _piece_by_piece(surface, polylines, snap)
+
+
+def _piece_by_piece(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap: float) -> CutMesh:
+    """Lines that cross, cut one after the other: the points of each line (densified to half the
+    mean edge length) go to the piece of the mould nearest to them, and each run of points over
+    one piece cuts that piece, from its boundary to its boundary (the run with a point of the
+    neighbouring pieces at either end: the line's end goes onto the splice it crosses there).
+    The pieces are then welded into one cut mesh, its lines the splices piece by piece."""
+    from scipy.spatial import cKDTree
+
+    from ..geometry.drawn_lines import closest_points
+    from ..geometry.surface_lines import min_angles
+    from ..geometry.weld import weld
+
+    edges = surface.points[surface.edges()]
+    spacing = 0.5 * float(np.linalg.norm(edges[:, 0] - edges[:, 1], axis=1).mean())
+    pieces, splices = [surface], []
+    for number, polyline in enumerate(polylines, start=1):
+        samples = _densified(polyline, spacing)
+        cursor = 0
+        while cursor < len(samples):
+            distance = np.array([closest_points(p, samples)[2] for p in pieces])
+            owner = np.argmin(distance, axis=0)
+            runs = _runs(owner, cursor)
+            for piece, first, last in runs:
+                portion = samples[max(first - 1, 0) : last + 2]
+                try:
+                    drawn, line = curves_on_surface(pieces[piece], [portion], snap)
+                    cut = cut_mesh(drawn, line, snap)
+                except CuttingError as exc:
+                    raise CuttingError(f"splice line {number}: {exc}") from None
+                cursor = last + 1
+                if cut.num_panels >= 2:  # (a run along a splice cuts nothing off)
+                    parts = split_panels(cut.mesh, cut.panel_ids)
+                    pieces[piece : piece + 1] = [part.mesh for part in parts]
+                    splices.append(cut.mesh.points[cut.lines[0]])
+                    break  # the pieces changed: their points again
+            else:
+                break
+    welded = weld(pieces)
+    panel_ids = np.concatenate(
+        [np.full(r["triangle"][1] - r["triangle"][0], k) for k, r in enumerate(welded.cell_ranges)]
+    )
+    tree = cKDTree(welded.mesh.points)
+    chains = [tree.query(points)[1] for points in splices]
+    seam_edges = np.unique(
+        np.sort(np.vstack([np.column_stack([c[:-1], c[1:]]) for c in chains]), axis=1), axis=0
+    )
+    cells = welded.mesh.cells["triangle"]
+    return CutMesh(
+        welded.mesh,
+        panel_ids,
+        chains,
+        seam_edges,
+        float(min_angles(welded.mesh.points, cells).min()),
+        float(min_angles(surface.points, surface.cells["triangle"]).min()),
+    )
+
+
+def _densified(polyline: np.ndarray, spacing: float) -> np.ndarray:
+    """Points along ``polyline`` at most ``spacing`` apart, its own among them."""
+    steps = np.linalg.norm(np.diff(polyline, axis=0), axis=1)
+    along = np.concatenate([[0.0], np.cumsum(steps)])
+    extra = np.linspace(0.0, along[-1], int(np.ceil(along[-1] / spacing)) + 1)
+    where = np.union1d(along, extra)
+    return np.column_stack([np.interp(where, along, polyline[:, k]) for k in range(3)])
+
+
+def _runs(owner: np.ndarray, start: int) -> list[tuple[int, int, int]]:
+    """From ``start`` on, the runs of consecutive points of one owner with at least two points:
+    ``(owner, first, last)``."""
+    out, first = [], start
+    for k in range(start + 1, len(owner) + 1):
+        if k == len(owner) or owner[k] != owner[first]:
+            if k - first >= 2:
+                out.append((int(owner[first]), first, k - 1))
+            first = k
+    return out
 
 
 def drape_pieces(
