@@ -1,9 +1,14 @@
 """Strips cut across into pieces where whole strips fit no roll (cross seams)."""
 
+import json
 from pathlib import Path
 
+import ezdxf
+import meshio
 import numpy as np
 import pytest
+from conftest import error_line, run
+from shapely.geometry import Polygon
 
 from vares.geometry.examples import cylinder160
 from vares.geometry.surface_lines import triangulated
@@ -114,3 +119,51 @@ def test_pieces_of_a_doubly_curved_surface_pattern_with_matched_cross_seams():
     points = np.vstack([np.unique(p.mesh.points, axis=0) for p in split.panels])
     _, shared = np.unique(points.round(9), axis=0, return_counts=True)
     assert shared.max() <= 3
+
+
+def test_vares_cut_lays_the_pieces_of_the_half_wave_on_a_half_metre_roll(tmp_path):
+    """``vares cut`` of half of compas-FoFin's wave (y ≥ 5 m: one valley, one ridge) at a 0.5 m
+    roll: whole strips do not get narrower (exit 2 with ``--cross-seams never``); by default
+    some are cut in two, and every piece is patterned (seams matched, each within 1 % of its
+    line), fits the roll and lies on it (nest.dxf: one seam outline a piece, none overlapping,
+    all within the roll); cut.json and structure.json say how many were cut."""
+    wave = read_mesh(DATA / "fofin_wave.obj")
+    quads = wave.cells["quad"]
+    half = quads[wave.points[quads].mean(axis=1)[:, 1] > 5.0]
+    used = np.unique(half)
+    index = np.full(wave.num_points, -1)
+    index[used] = np.arange(used.size)
+    source = tmp_path / "half_wave.obj"
+    meshio.write(source, meshio.Mesh(wave.points[used], [("quad", index[half])]))
+    args = [
+        "cut", source, "--roll-width", 0.5, "--units", "m", "--fabric", "pes-pvc-type-2",
+        "--prestress", "2,1.5", "--allowance", 20, "--edge-type", "cable",
+        "--cable-allowance", 80, "--nest-time", 2,
+    ]  # fmt: skip
+    refused = run(*args, "--cross-seams", "never", "-o", tmp_path / "whole", "-q")
+    assert refused.exit_code == 2
+    assert "do not get narrower with their number" in error_line(refused)
+    out = tmp_path / "pieces"
+    result = run(*args, "-o", out)
+    assert result.exit_code == 0, result.stderr
+    details = json.loads((out / "structure.json").read_text())["cutting"]
+    cross = details["cross_seams"]
+    assert cross["strips_cut"] >= 1 and cross["pieces_each"] == 2
+    assert any("cut across into 2 pieces" in note for note in details["notes"])
+    assert details["nest"] is not None and details["widest_pattern_per_round"][-1] <= 0.5
+    for line in details["seam_lines"]:
+        assert abs(line["excess"]) < 0.01
+    data = json.loads((out / "cut.json").read_text())
+    panels = data["panels"]
+    assert sum(p["name"][-1] in "ab" for p in panels) == 2 * cross["strips_cut"]
+    assert sum(p["area"] for p in panels) == pytest.approx(details["panels_area"], rel=1e-12)
+    for seam in data["seams"]:
+        a, b = seam["length_2d"]
+        assert abs(a - b) <= 1e-9 * a
+    space = ezdxf.readfile(out / "nest.dxf").modelspace()
+    drawn = [Polygon(np.array(e.get_points("xy"))) for e in space.query("LWPOLYLINE[layer=='CUT']")]
+    assert len(drawn) == len(panels)
+    assert max(p.bounds[3] for p in drawn) <= 500 and min(p.bounds[1] for p in drawn) >= 0
+    for k, first in enumerate(drawn):
+        for second in drawn[k + 1 :]:
+            assert not first.intersects(second)

@@ -199,7 +199,7 @@ def _lines_figure(outcome: JobOutcome):
 
     plan = outcome.cut.plan
     title = (
-        f"{len(plan.panels)} strips, {outcome.cut.options.seams} cutting lines, roll width "
+        f"{plan.counted}, {outcome.cut.options.seams} cutting lines, roll width "
         f"{outcome.cut.options.roll_width:g} {outcome.units}"
     )
     return plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines, title=title)

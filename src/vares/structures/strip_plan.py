@@ -63,6 +63,13 @@ class StripPlan:
     pieces: int = 1
     cross_cut: int = 0
 
+    @property
+    def counted(self) -> str:
+        """``"12 strips"``, or ``"96 pieces of 68 strips"`` where strips were cut across."""
+        if self.cross_cut:
+            return f"{len(self.panels)} pieces of {len(set(self.strip_of))} strips"
+        return f"{len(self.panels)} strips"
+
 
 def along_strips(
     cut: CutMesh, panels: list[Panel], family, one_seam: bool = False

@@ -234,13 +234,8 @@ def _show_cut(outcome: JobOutcome) -> None:
         if result.options.seams == "curves"
         else f"of {result.options.seams} lines ({plan.evaluations} layouts tried)"
     )
-    pieces = (
-        f"{len(plan.panels)} pieces of {len(set(plan.strip_of))} strips"
-        if plan.cross_cut
-        else f"{len(plan.panels)} strips"
-    )
     console.print(
-        f"cut: {pieces} {lines}, widest {max(result.widths):.4g} {units} with "
+        f"cut: {plan.counted} {lines}, widest {max(result.widths):.4g} {units} with "
         f"allowances (roll {result.options.roll_width:g}); worst cell angle "
         f"{plan.cut.worst_angle:.1f}° (surface {result.surface_worst_angle:.1f}°); area 3D "
         f"{result.panel_area:.6g} of {result.surface_area:.6g} {units}²"
