@@ -102,6 +102,16 @@ def test_pieces_of_a_doubly_curved_surface_pattern_with_matched_cross_seams():
     assert len(plan.panels) >= 3
     split = split_across(plan, 0.0, 2)
     assert len(split.panels) == 2 * len(plan.panels)
+    # each piece's warp along its own part of the seams; a warp given for all stays as given
+    own = [
+        np.degrees(np.arccos(min(1.0, w @ plan.warps[s])))
+        for w, s in zip(split.warps, split.strip_of, strict=True)
+    ]
+    assert max(own) > 0.1
+    given = split_across(plan, 0.0, 2, own_warps=False)
+    assert all(
+        np.array_equal(w, plan.warps[s]) for w, s in zip(given.warps, given.strip_of, strict=True)
+    )
     fabric = vares.materials.fabric("pes-pvc-type-2").material()
     result = solve_structure(
         split.panels,

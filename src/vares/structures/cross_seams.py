@@ -37,11 +37,14 @@ MAX_PIECES = 6
 STAGGER = 0.04
 
 
-def split_across(plan: StripPlan, width: float, pieces: int, snap: float = SNAP) -> StripPlan:
+def split_across(
+    plan: StripPlan, width: float, pieces: int, snap: float = SNAP, *, own_warps: bool = True
+) -> StripPlan:
     """``plan`` with every strip wider than ``width`` (by ``plan.widths``) cut across into
-    ``pieces`` parts (module docs); ``strip_of`` of the result gives each piece's strip. The
-    widths and lengths are left for the caller to measure again. Unchanged where no strip is
-    too wide or ``pieces`` is 1."""
+    ``pieces`` parts (module docs); ``strip_of`` of the result gives each piece's strip. Each
+    piece's warp runs along its part of the strip's seams, or (not ``own_warps``: a warp
+    direction given for all) is its strip's. The widths and lengths are left for the caller to
+    measure again. Unchanged where no strip is too wide or ``pieces`` is 1."""
     if pieces < 1 or pieces > MAX_PIECES:
         raise ValueError(f"pieces must be 1 … {MAX_PIECES}; got {pieces!r}")
     wide = [k for k, w in enumerate(plan.widths) if w > width]
@@ -81,7 +84,7 @@ def split_across(plan: StripPlan, width: float, pieces: int, snap: float = SNAP)
         further.input_worst_angle,
     )
     panels = split_panels(split.mesh, ids, names)
-    if plan.straight_warp or plan.interlock:
+    if not own_warps or plan.straight_warp or plan.interlock:
         warps = [plan.warps[s] for s in strip_of]
     else:
         seams_only = replace(split, lines=list(cut.lines))  # each piece's part of its seams

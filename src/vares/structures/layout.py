@@ -135,7 +135,7 @@ def plan_strips(
         plan.interlock = interlock
         plan.widths = strip_widths(plan, family, seam_allowance, edge_allowance)
         if pieces > 1:
-            plan = split_across(plan, width, pieces, snap)
+            plan = split_across(plan, width, pieces, snap, own_warps=warp_direction is None)
             plan.widths = strip_widths(plan, family, seam_allowance, edge_allowance)
         plan.input_cells = input_cells
         return plan, _gap_widths(plan, family, spans)
