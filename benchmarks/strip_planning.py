@@ -8,6 +8,7 @@ Each case runs in a fresh process (``PYTHONPATH`` = this tree's ``src``, or ``--
 the two trees in turn, so that both see the same machine. Cases: ``sail-9`` (compas_fd's 90 m
 four-point sail, ``tests/data/hypar_sail.obj``, at a 9 m roll), ``sail-9-pairs`` (the same in
 pairs), ``sail-5``, ``sail-2.5``, ``wave-1`` (compas-FoFin's 10 m wave at 1 m), ``wave-1-pairs``,
+``wave-0.5`` (whole strips refused: cut across, "strips" counts the pieces),
 ``tent-2.5-pairs`` (``tent_roof()`` at 2.5 m in pairs, as ``vares cut --example conic-tent``
 plans it) and ``tent-1.5-pairs``.
 """
@@ -31,6 +32,7 @@ CASES = {
     "sail-2.5": ("hypar_sail.obj", 2.5, False),
     "wave-1": ("fofin_wave.obj", 1.0, False),
     "wave-1-pairs": ("fofin_wave.obj", 1.0, True),
+    "wave-0.5": ("fofin_wave.obj", 0.5, False),
     "tent-2.5-pairs": ("tent", 2.5, True),
     "tent-1.5-pairs": ("tent", 1.5, True),
 }
@@ -50,7 +52,8 @@ start = time.perf_counter()
 plan = plan_strips(mesh, width, interlock=pairs)
 print(json.dumps({"seconds": time.perf_counter() - start, "evaluations": plan.evaluations,
                   "strips": len(plan.widths), "gaps": [c for c, _ in plan.history],
-                  "widest": max(plan.widths), "cells": plan.refined_cells}))
+                  "widest": max(plan.widths), "cells": plan.refined_cells,
+                  "cut_across": getattr(plan, "cross_cut", 0)}))
 """
 
 
@@ -93,8 +96,11 @@ def main() -> None:
                 print(f"| {case} | {label} | {r['error']} | | | | | |", flush=True)
                 continue
             times[label] = r["seconds"]
+            strips = (
+                f"{r['strips']} ({r['cut_across']} cut across)" if r["cut_across"] else r["strips"]
+            )
             print(
-                f"| {case} | {label} | {r['evaluations']} | {r['gaps']} | {r['strips']} | "
+                f"| {case} | {label} | {r['evaluations']} | {r['gaps']} | {strips} | "
                 f"{r['widest']:.3f} | {r['cells']:,} | {r['seconds']:.1f} |",
                 flush=True,
             )
