@@ -208,3 +208,36 @@ def test_a_cut_has_one_roll_width(small_saddle_file):
         Job.from_dict({**table, "structure": {"roll_width": 3.0}})
     with pytest.raises(ValueError, match="a cut has one roll width"):
         vares.cut(mesh, FABRIC, roll_width=2.5, structure=StructureOptions(roll_width=3.0))
+
+
+def test_a_cut_whose_patterns_the_roll_does_not_take_exits_1(tmp_path, monkeypatch):
+    """The wave at a 1 m roll: its first plan's patterns are wider than the roll (1.081 m with
+    allowances, docs/cutting.md), and with one plan allowed the cut ends there. Its files are
+    written with no nest, and ``vares cut`` exits 1 naming the pieces (it exited 0 before)."""
+    import vares.structures.cutting as cutting
+
+    monkeypatch.setattr(cutting, "MAX_ROUNDS", 1)
+    source = Path(__file__).parent / "data" / "fofin_wave.obj"
+    out = tmp_path / "wave"
+    result = run(
+        "cut", source, "--units", "m", "--roll-width", 1.0, "-o", out,
+        "--fabric", "pes-pvc-type-2", "--prestress", "2,1.5", "--allowance", 20,
+        "--edge-type", "cable", "--cable-allowance", 80, "--nest-time", 1, "-q",
+        "--save-job", tmp_path / "wave.toml",
+    )  # fmt: skip
+    assert result.exit_code == 1
+    message = error_line(result)
+    assert message.startswith("vares: error: the cut does not fit the roll: strip-")
+    assert "after 1 plan, so nothing was nested" in message
+    details = json.loads((out / "structure.json").read_text())["cutting"]
+    assert details["nest"] is None and details["widest_pattern_per_round"][0] > 0.99992
+    assert not (out / "nest.dxf").exists()
+    # in a batch the job failed, and a later batch runs it again rather than skip it
+    from vares.app.batch import is_complete, run_job_file
+    from vares.app.job import load_job
+
+    saved = tmp_path / "wave.toml"
+    status = run_job_file(str(saved))
+    assert status.status == "failed", status.message
+    assert status.message.startswith("the cut does not fit the roll")
+    assert not is_complete(load_job(saved))

@@ -50,11 +50,13 @@ def _previous(job: Job) -> dict:
 
 
 def is_complete(job: Job) -> bool:
-    """True when the job's outputs exist, converged, and were written for this very job (and,
-    with an erection, its ``erect.json`` says it converged)."""
+    """True when the job's outputs exist, converged, and were written for this very job (a cut
+    with its nest; with an erection, its ``erect.json`` says it converged)."""
     data = _previous(job)
     if not (data.get("converged") and data.get("job_digest") == job.digest()):
         return False
+    if job.cut is not None and not (data.get("cutting") or {}).get("nest"):
+        return False  # a cut with no nest: its patterns did not fit the roll
     if job.erection is None:
         return True
     try:
@@ -101,6 +103,8 @@ def run_job_file(path: str, force: bool = False) -> JobStatus:
             if outcome.converged
             else str(outcome.reason)
         )
+        if outcome.converged and outcome.unfit:  # patterned, but no nest on this roll
+            status, message = "failed", outcome.unfit
         return JobStatus(str(path), status, message, time.perf_counter() - started, output)
     except Exception as exc:  # a failing job is reported, the batch goes on
         return JobStatus(

@@ -92,6 +92,21 @@ class JobOutcome:
         return None
 
     @property
+    def unfit(self) -> str | None:
+        """Why a cut whose patterns converged is of no use on its roll (pieces wider than the
+        roll takes, so nothing was nested), or None."""
+        cut = self.cut
+        if cut is None or not cut.too_wide:
+            return None
+        names = ", ".join(cut.plan.panels[k].name for k in cut.too_wide)
+        plans = "1 plan" if len(cut.rounds) == 1 else f"{len(cut.rounds)} plans"
+        return (
+            f"the cut does not fit the roll: {names} wider than it takes "
+            f"({cut.usable_width:.6g} {self.units}) after {plans}, so nothing was nested: try "
+            "another strip direction or layout, or a wider roll"
+        )
+
+    @property
     def result(self) -> PatternResult:
         """The pattern of a single-surface job."""
         if self.structure is not None:

@@ -377,3 +377,5 @@ def execute(job: Job, *, force: bool, quiet: bool, save_job: Path | None = None)
         raise typer.Exit(fail(f"the {what} did not converge: {outcome.reason}", 1))
     if not outcome.converged:
         raise typer.Exit(fail(f"the erection did not converge: {outcome.erection.reason}", 1))
+    if outcome.unfit:  # patterned, but not on this roll: no nest
+        raise typer.Exit(fail(outcome.unfit, 1))
