@@ -136,7 +136,7 @@ def test_vares_cut_lays_the_pieces_of_the_half_wave_on_a_half_metre_roll(tmp_pat
     roll: whole strips do not get narrower (exit 2 with ``--cross-seams never``); by default
     some are cut in two, and every piece is patterned (seams matched, each within 1 % of its
     line), fits the roll and lies on it (nest.dxf: one seam outline a piece, none overlapping,
-    all within the roll); cut.json and structure.json say how many were cut."""
+    all within the roll); cut.json, structure.json and the report say how many were cut."""
     wave = read_mesh(DATA / "fofin_wave.obj")
     quads = wave.cells["quad"]
     half = quads[wave.points[quads].mean(axis=1)[:, 1] > 5.0]
@@ -154,7 +154,7 @@ def test_vares_cut_lays_the_pieces_of_the_half_wave_on_a_half_metre_roll(tmp_pat
     assert refused.exit_code == 2
     assert "do not get narrower with their number" in error_line(refused)
     out = tmp_path / "pieces"
-    result = run(*args, "-o", out)
+    result = run(*args, "-o", out, "--report")
     assert result.exit_code == 0, result.stderr
     details = json.loads((out / "structure.json").read_text())["cutting"]
     cross = details["cross_seams"]
@@ -170,6 +170,9 @@ def test_vares_cut_lays_the_pieces_of_the_half_wave_on_a_half_metre_roll(tmp_pat
     for seam in data["seams"]:
         a, b = seam["length_2d"]
         assert abs(a - b) <= 1e-9 * a
+    strips = len({p["name"].rstrip("ab") for p in panels})
+    row = f"{strips}, {cross['strips_cut']} cut across: {len(panels)} pieces"
+    assert row in (out / "report.html").read_text()
     space = ezdxf.readfile(out / "nest.dxf").modelspace()
     drawn = [Polygon(np.array(e.get_points("xy"))) for e in space.query("LWPOLYLINE[layer=='CUT']")]
     assert len(drawn) == len(panels)
