@@ -230,6 +230,11 @@ def test_splice_lines_that_do_not_cut_the_mould_are_refused():
     inside = axis_splice("x")[150:250]  # ends on the domes, away from the outline
     with pytest.raises(CuttingError, match="boundary"):
         solve_with_splices(mould, NCF, locking_angle=LOCKING, polylines=[inside])
+    # the same splice twice: the second runs along the first (it said "curve 1 is shorter than
+    # a cell of the mesh" before)
+    twice = [axis_splice("x"), axis_splice("x")]
+    with pytest.raises(CuttingError, match="splice line 2 runs along a splice cut before it"):
+        solve_with_splices(mould, NCF, locking_angle=LOCKING, polylines=twice)
 
 
 def test_drape_command_with_splice_lines(tmp_path):

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..geometry.cutting import CutMesh, LinesMeetError, cut_mesh
-from ..geometry.drawn_lines import curves_on_surface
+from ..geometry.drawn_lines import curves_on_surface, densified
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.surface_lines import CuttingError, triangulated
 from ..materials import Hyperelastic
@@ -235,15 +235,14 @@ def _piece_by_piece(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap:
     The pieces are then welded into one cut mesh, its lines the splices piece by piece."""
     from scipy.spatial import cKDTree
 
-    from ..geometry.drawn_lines import closest_points
+    from ..geometry.drawn_lines import closest_points, point_spacing
     from ..geometry.surface_lines import min_angles
     from ..geometry.weld import weld
 
-    edges = surface.points[surface.edges()]
-    spacing = 0.5 * float(np.linalg.norm(edges[:, 0] - edges[:, 1], axis=1).mean())
+    spacing = point_spacing(surface)
     pieces, splices = [surface], []
     for number, polyline in enumerate(polylines, start=1):
-        samples = _densified(polyline, spacing)
+        samples = densified(polyline, spacing)
         cursor = 0
         while cursor < len(samples):
             distance = np.array([closest_points(p, samples)[2] for p in pieces])
@@ -255,6 +254,11 @@ def _piece_by_piece(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap:
                     drawn, line = curves_on_surface(pieces[piece], [portion], snap)
                     cut = cut_mesh(drawn, line, snap)
                 except CuttingError as exc:
+                    if _along(samples[first : last + 1], splices, spacing):
+                        raise CuttingError(
+                            f"splice line {number} runs along a splice cut before it: draw "
+                            "every splice once, each across the mould"
+                        ) from None
                     raise CuttingError(f"splice line {number}: {exc}") from None
                 cursor = last + 1
                 if cut.num_panels >= 2:  # (a run along a splice cuts nothing off)
@@ -284,13 +288,17 @@ def _piece_by_piece(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap:
     )
 
 
-def _densified(polyline: np.ndarray, spacing: float) -> np.ndarray:
-    """Points along ``polyline`` at most ``spacing`` apart, its own among them."""
-    steps = np.linalg.norm(np.diff(polyline, axis=0), axis=1)
-    along = np.concatenate([[0.0], np.cumsum(steps)])
-    extra = np.linspace(0.0, along[-1], int(np.ceil(along[-1] / spacing)) + 1)
-    where = np.union1d(along, extra)
-    return np.column_stack([np.interp(where, along, polyline[:, k]) for k in range(3)])
+def _along(points: np.ndarray, splices: list[np.ndarray], spacing: float) -> bool:
+    """Whether most of ``points`` (``spacing`` apart) lie within ``spacing`` of the ``splices``
+    cut so far (drawn through nodes, a splice runs up to :data:`SPLICE_SNAP` of an edge from its
+    curve): a line drawn along one. Asked only of a part of a line that could not be cut."""
+    if not splices:
+        return False
+    from scipy.spatial import cKDTree
+
+    near = cKDTree(np.vstack([densified(s, 0.25 * spacing) for s in splices]))
+    distance, _ = near.query(points)
+    return bool(np.median(distance) < spacing)
 
 
 def _runs(owner: np.ndarray, start: int) -> list[tuple[int, int, int]]:

@@ -371,12 +371,7 @@ def _cut_section(outcome: JobOutcome) -> list[str]:
     key = [
         ("roll width", f"{result.options.roll_width:g} {units}"),
         ("cutting lines", f"{result.options.seams}, {len(plan.lines)}"),
-        (
-            "strips",
-            f"{len(set(plan.strip_of))}, {plan.cross_cut} cut across: {len(plan.panels)} pieces"
-            if plan.cross_cut
-            else len(plan.panels),
-        ),
+        ("strips", plan.counted),
         ("widest pattern with allowances", f"{number(max(result.widths))} {units}"),
         (
             "worst cell angle",

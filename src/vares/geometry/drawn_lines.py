@@ -20,7 +20,7 @@ from .cutting import cut_mesh
 from .mesh import SurfaceMesh
 from .surface_lines import CuttingError, EdgeLocator, SurfaceLine, check_triangles
 
-__all__ = ["closest_points", "curves_on_surface"]
+__all__ = ["closest_points", "curves_on_surface", "densified", "point_spacing"]
 
 
 def curves_on_surface(
@@ -31,12 +31,11 @@ def curves_on_surface(
     import potpourri3d as pp3d
 
     check_triangles(mesh)  # triangles only
-    edges = mesh.edges()
-    spacing = 0.5 * float(np.linalg.norm(np.diff(mesh.points[edges], axis=1), axis=2).mean())
+    spacing = point_spacing(mesh)
     size = float(np.ptp(mesh.points, axis=0).max())
     located = []
     for index, curve in enumerate(curves, start=1):
-        points = _densified(np.asarray(curve, dtype=float), spacing)
+        points = densified(np.asarray(curve, dtype=float), spacing)
         faces, bary, distance = closest_points(mesh, points)
         if distance.max() > 0.05 * size:
             raise CuttingError(
@@ -59,7 +58,15 @@ def curves_on_surface(
     return base, lines
 
 
-def _densified(curve: np.ndarray, spacing: float) -> np.ndarray:
+def point_spacing(mesh: SurfaceMesh) -> float:
+    """The spacing a curve is densified to before it is drawn on ``mesh``: half its mean edge."""
+    edges = mesh.edges()
+    return 0.5 * float(np.linalg.norm(np.diff(mesh.points[edges], axis=1), axis=2).mean())
+
+
+def densified(curve: np.ndarray, spacing: float) -> np.ndarray:
+    """The polyline ``curve`` ``(k, 3)`` with points added: its own kept, none farther apart
+    than ``spacing``."""
     out = [curve[:1]]
     for a, b in itertools.pairwise(curve):
         pieces = max(1, int(np.ceil(np.linalg.norm(b - a) / spacing)))

@@ -52,13 +52,17 @@ def split_across(
         return plan
     cut = plan.cut
     taken: set[int] = set()  # nodes where a cross seam ends
-    lines = [line for k in wide for line in _cross_lines(plan, k, pieces, taken)]
+    across = {k: _cross_lines(plan, k, pieces, taken) for k in wide}
+    lines = [line for k in wide for line in across[k]]
     if not lines:
         return plan
     further = cut_across(cut, lines, snap)
+    # cut_across keeps the panels' order, the parts of a split one right after it: each line
+    # adds one part to its strip
+    parts = [1 + len(across.get(k, ())) for k in range(cut.num_panels)]
+    located = np.repeat(np.arange(cut.num_panels), parts)
     strip_of = np.empty(further.num_panels, dtype=np.int64)
     cells = further.mesh.cells["triangle"]
-    located = _strips_of(cut, further)
     order = []
     for piece in range(further.num_panels):
         mine = further.panel_ids == piece
@@ -98,21 +102,6 @@ def split_across(
         strip_of=strip_of.tolist(),
         pieces=pieces,
         cross_cut=len(wide),
-    )
-
-
-def _strips_of(cut: CutMesh, further: CutMesh) -> np.ndarray:
-    """The strip of ``cut`` every panel of ``further`` (``cut`` cut across) lies in."""
-    from ..geometry.surface_points import FaceLocator
-
-    cells = further.mesh.cells["triangle"]
-    faces, _, _ = FaceLocator(cut.mesh).locate(further.mesh.points[cells].mean(axis=1))
-    before = cut.panel_ids[faces]
-    return np.array(
-        [
-            np.bincount(before[further.panel_ids == piece]).argmax()
-            for piece in range(further.num_panels)
-        ]
     )
 
 
