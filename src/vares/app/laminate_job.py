@@ -32,6 +32,9 @@ materials::
     region = "zone"             # a cell field of the mould; region_value = 2 picks one value
     drop_off = 1
     darts = "auto"              # or dart_lines = "darts.txt"; default: the laminate's darts
+    [[ply]]
+    name = "P3"
+    splice_lines = "splices.txt"  # the ply cut into pieces along these lines (no darts then)
 
 Every table and key is checked against its options class; an unknown one is an error naming the
 closest valid spelling. ``[fibres] warp_direction`` is refused (each ply's orientation sets it),
@@ -44,6 +47,8 @@ import difflib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..options import Options, OptionsError, suggest
 from ..structures.laminate import Ply
@@ -151,17 +156,23 @@ class LaminateJob:
                 material = named[options.material]
             else:
                 material = default
-            lines = None
-            if options.dart_lines is not None:
-                from ..io.curves import read_curves
-
-                path = self.job.path(options.dart_lines)
-                try:
-                    lines = tuple(read_curves(path))
-                except (OSError, ValueError) as exc:
-                    raise JobError(f"[[ply]] {options.name} dart_lines: {exc}") from None
-            plies.append(Ply(options, material, lines))
+            lines = {
+                key: self._curves(options.name, key, getattr(options, key))
+                for key in ("dart_lines", "splice_lines")
+            }
+            plies.append(Ply(options, material, lines["dart_lines"], lines["splice_lines"]))
         return plies
+
+    def _curves(self, ply: str, key: str, file: str | None) -> tuple[np.ndarray, ...] | None:
+        """The lines of a ply's curves file ``file`` (its ``key``), or None without one."""
+        if file is None:
+            return None
+        from ..io.curves import read_curves
+
+        try:
+            return tuple(read_curves(self.job.path(file)))
+        except (OSError, ValueError) as exc:
+            raise JobError(f"[[ply]] {ply} {key}: {exc}") from None
 
     def with_output(self, directory: str | Path) -> LaminateJob:
         """The same job writing into ``directory``."""

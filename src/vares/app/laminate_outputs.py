@@ -16,9 +16,11 @@ Into the job's output folder (replaced as a whole when the run succeeds, see
   the shear angle (those of the mechanical drape, or of the kinematic net with
   ``fe_directions = "kinematic"``);
 - ``patterns/<drape>.vtu``: each distinct blank, flat, with its per-cell fields (a darted ply's
-  opened along its darts);
+  opened along its darts; a spliced ply's pieces one above the other, with the cell field
+  ``piece``, 1 for the first);
 - ``plies/<ply>.dxf``: each ply's cutter file, net and extended (trim) boundaries, rosette,
-  label and dart lines (:mod:`vares.io.ply_dxf`); ``nest.dxf``: every ply nested on the roll (with a
+  label and dart lines (:mod:`vares.io.ply_dxf`; a spliced ply's pieces side by side);
+  ``nest.dxf``: every ply (every piece of a spliced one) nested on the roll (with a
   ``roll_width``);
 - ``plybook.html``: the ply book (:mod:`vares.app.ply_book`).
 
@@ -36,11 +38,11 @@ from typing import Any
 import numpy as np
 
 from ..io.files import write_json, write_text
-from ..io.meshes import write_surface
+from ..io.meshes import write_surface, write_surfaces
 from ..io.orientations import PlyOrientations, write_abaqus_orientations, write_orientation_csv
 from ..io.ply_dxf import write_ply_dxf, write_ply_nest_dxf
 from ..structures.laminate import PAIR_VALUES, LaminateResult, PlyDrapeResult, drape_laminate
-from ..structures.laminate_blanks import PlyBlank, nest_plies, ply_blanks
+from ..structures.laminate_blanks import PlyBlank, nest_plies, ply_blanks, side_by_side
 from ..structures.laminate_pairs import PAIR_TITLES
 from ..structures.nesting import RollNest
 from .inputs import load_input, safe_name
@@ -106,10 +108,11 @@ class LaminateRun:
         """``laminate.json``: the laminate's summary with ``blanks`` and ``nest``."""
         blanks = []
         for blank in self.blanks:
-            check = ply_producibility(self.result, blank.name)
+            check = ply_producibility(self.result, blank.name, blank.piece)
             blanks.append(
                 {
                     "ply": blank.name,
+                    "piece": blank.piece,
                     "net_area": blank.net_area,
                     "trim_area": blank.trim_area,
                     "surface_area": blank.surface_area,
@@ -132,6 +135,7 @@ class LaminateRun:
                 "pieces": [
                     {
                         "ply": self.blanks[p.index].name,
+                        "piece": self.blanks[p.index].piece,
                         "rotation": p.rotation,
                         "translation": list(p.translation),
                     }
@@ -228,6 +232,9 @@ def _matrix_lines(result: LaminateResult, value: str) -> list[str]:
 
 
 def _darts_cell(drape: PlyDrapeResult) -> str:
+    if drape.spliced is not None:
+        spliced = drape.spliced
+        return f"spliced: {len(spliced.pieces)} pieces ({spliced.max_shear_after:.2f}°)"
     if drape.darted is None:
         return "–"
     if drape.darted.after is not None and not drape.is_darted:
@@ -264,7 +271,7 @@ def laminate_markdown(result: LaminateResult) -> str:
     lines += [
         "",
         "| drape | converged | iterations | energy | largest shear | kinematic largest shear "
-        "| mean difference | darts (largest shear with them) | seconds |",
+        "| mean difference | darts or splices (largest shear with them) | seconds |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for drape in result.drapes:
@@ -298,7 +305,7 @@ def cutting_markdown(run: LaminateRun) -> str:
     for blank in run.blanks:
         mass = blank.mass(blank.net_area, units)
         lines.append(
-            f"| {blank.name} | {blank.orientation:+g}° | {blank.net_area:.6g} | "
+            f"| {blank.label} | {blank.orientation:+g}° | {blank.net_area:.6g} | "
             f"{blank.trim_area:.6g} | {'–' if mass is None else f'{mass:.4g}'} |"
         )
     nest = run.nest
@@ -334,14 +341,36 @@ def write_laminate(folder: OutputFolder, job: LaminateJob, run: LaminateRun) -> 
     if run.nest is not None:
         write_ply_nest_dxf(staged["nest.dxf"], run.blanks, run.nest, units=run.units)
     dxf = [p for p in paths if p.parent.name == "plies"]
-    for blank, path in zip(run.blanks, dxf, strict=True):
-        write_ply_dxf(folder.staged(path), blank, units=run.units)
+    for ply, path in zip(result.laminate.plies, dxf, strict=True):
+        pieces = [b for b in run.blanks if b.name == ply.name]
+        write_ply_dxf(folder.staged(path), pieces, units=run.units)
     vtu = [p for p in paths if p.parent.name == "patterns"]
     for drape, path in zip(result.drapes, vtu, strict=True):
-        pattern = drape.blank_pattern
-        write_surface(
-            folder.staged(path), drape.blank_mesh, pattern.material_coordinates, pattern.fields
-        )
+        if drape.is_spliced:
+            write_surfaces(folder.staged(path), _flat_pieces(drape, run.blanks))
+        else:
+            pattern = drape.blank_pattern
+            write_surface(
+                folder.staged(path), drape.blank_mesh, pattern.material_coordinates, pattern.fields
+            )
+
+
+def _flat_pieces(drape: PlyDrapeResult, blanks: list[PlyBlank]):
+    """A spliced drape's pieces as parts of one file (:func:`write_surfaces`): each piece's
+    mesh, its pattern placed as in the ply's cutter file, and its own cell fields."""
+    first = drape.plies[0]
+    pieces = [b for b in blanks if b.name == first]
+    parts = []
+    for blank, shift, (_, _, result) in zip(
+        pieces, side_by_side(pieces), drape.pieces, strict=True
+    ):
+        own = {
+            name: np.asarray(value)
+            for name, value in result.fields.items()
+            if np.shape(value)[:1] == (blank.mesh.num_cells,)
+        }
+        parts.append((blank.mesh, blank.coordinates + shift, own))
+    return parts
 
 
 def run_laminate_job(
@@ -360,7 +389,12 @@ def run_laminate_job(
     inputs = [job.job.path(p) for p in job.job.input.paths]
     if job.job.location is not None:
         inputs.append(job.job.location)
-    inputs += [job.job.path(p.dart_lines) for p in job.plies if p.dart_lines is not None]
+    inputs += [
+        job.job.path(file)
+        for p in job.plies
+        for file in (p.dart_lines, p.splice_lines)
+        if file is not None
+    ]
     folder = OutputFolder(
         job.directory, laminate_files(job), force=force, inputs=inputs, command="laminate"
     )

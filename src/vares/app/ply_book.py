@@ -8,6 +8,7 @@ rosette (the 0° arrow along the warp, the 90° arrow along the fill, at the see
 producibility maps (a darted ply's dart lines drawn on the blank and on both maps), its numbers,
 and its darts: their lengths on the mould, the mouths' openings in the blank and the largest
 shear before and after, or, without darts, how much of the ply is at or beyond the locking angle.
+A spliced ply has a section per piece, with the splices instead of the darts.
 
 Producibility here is that of the blank as cut (opened along its darts, if any): the mechanical
 drape's shear angle against the ply's locking angle (its own, the laminate's or its fabric
@@ -38,13 +39,15 @@ BOOK_MATRICES = ("warp_compressed_fraction", "largest_compression", "mean_deviat
 _CLASS_COLOURS = ("#4caf50", "#ffb300", "#d32f2f", "#bdbdbd")
 
 
-def ply_producibility(result: LaminateResult, name: str) -> Producibility:
+def ply_producibility(result: LaminateResult, name: str, piece: str | None = None) -> Producibility:
     """The producibility of ply ``name``'s blank as cut: its mechanical shear angle per cell of
-    the blank's mesh (opened along its darts, if any) against the ply's locking angle."""
+    the blank's mesh (opened along its darts, if any; of its piece ``piece`` when spliced)
+    against the ply's locking angle."""
     drape = result.drape(name)
+    _, mesh, pattern = drape.piece(piece)
     return producibility(
-        drape.blank_pattern.fields["shear_angle"],
-        drape.blank_mesh.cell_areas(),
+        pattern.fields["shear_angle"],
+        mesh.cell_areas(),
         drape.locking_angle,
         DrapeOptions().warn_fraction,
     )
@@ -98,7 +101,7 @@ def _blank_figure(blank: PlyBlank, units: str):
     ax.plot(*blank.origin, "o", color="black", ms=4)
     darts = f", {len(blank.darts)} dart(s) (purple)" if blank.darts else ""
     ax.set_title(
-        f"{blank.name}: flat blank, net (black) and trim (red, +{blank.allowance:g}){darts}"
+        f"{blank.label}: flat blank, net (black) and trim (red, +{blank.allowance:g}){darts}"
     )
     ax.set_xlabel(f"along the warp [{units}]")
     ax.set_ylabel(f"[{units}]")
@@ -129,7 +132,7 @@ def _producibility_figure(blank: PlyBlank, check: Producibility):
         for n in CLASSES[:3]
     ]
     ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.06), ncols=3, fontsize=8)
-    ax.set_title(f"{blank.name}: producibility (shear against the locking angle)")
+    ax.set_title(f"{blank.label}: producibility (shear against the locking angle)")
     return fig
 
 
@@ -148,7 +151,7 @@ def _summary_rows(result, blanks, checks, units) -> list[tuple]:
         f = check.fractions
         rows.append(
             (
-                blank.name,
+                blank.label,
                 f"{blank.orientation:+g}°",
                 blank.drape,
                 _optional(blank.thickness, "mm"),
@@ -164,7 +167,9 @@ def _summary_rows(result, blanks, checks, units) -> list[tuple]:
 
 def _stacking(blanks: Sequence[PlyBlank], result: LaminateResult) -> list[str]:
     rows, height = [], 0.0
-    for position, (blank, ply) in enumerate(zip(blanks, result.laminate.plies, strict=True), 1):
+    first = {b.name: b for b in reversed(blanks)}  # a spliced ply's pieces: one layer
+    for position, ply in enumerate(result.laminate.plies, 1):
+        blank = first[ply.name]
         top = None if blank.thickness is None or height is None else height + blank.thickness
         drop = ply.options.drop_off
         region = ply.options.region or "whole mould"
@@ -221,7 +226,7 @@ def _nest_section(nest: RollNest | None, blanks, units: str) -> list[str]:
         warp = np.array([np.cos(angle), np.sin(angle)])
         drawings.append(
             NestedDrawing(
-                blank.name, piece.place(blank.net[0]), piece.place(blank.trim[0]), warp, ()
+                blank.label, piece.place(blank.net[0]), piece.place(blank.trim[0]), warp, ()
             )
         )
     fig = plot_nest(nest.roll_width, nest.length, drawings, units=units)
@@ -254,8 +259,11 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
         ("locking angle", f"{number(check.locking_angle, 4)}°"),
     ]
     rows += [(f"area {n}", f"{100 * check.fractions[n]:.2f} %") for n in CLASSES[:3]]
-    if drape.kinematic is not None:
-        net = drape.kinematic.producibility
+    net = drape.kinematic.producibility if drape.kinematic is not None else None
+    if drape.spliced is not None and drape.spliced.nets is not None:  # the piece's own net
+        own = drape.spliced.nets[[p.name for p in drape.spliced.pieces].index(blank.piece)]
+        net = own.producibility if own is not None else None
+    if net is not None:
         rows.append(
             (
                 "kinematic net: ok / warn / limit",
@@ -263,17 +271,43 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
             )
         )
     state = rows.pop(3)  # its cell holds markup: not escaped
-    ident = html.escape(blank.name)
+    ident = html.escape(blank.name if blank.piece is None else f"{blank.name}-{blank.piece}")
+    heading = html.escape(blank.name)
+    if blank.piece is not None:
+        heading += f", {html.escape(blank.piece)} of {blank.pieces}"
+    if drape.spliced is not None:
+        lines = ["<h3>Splices</h3>", *_splices_part(drape, blank, check, ident, units)]
+    else:
+        lines = ["<h3>Darts</h3>", *_darts_part(drape, check, ident, units)]
     return [
         f"<section class='ply' id='ply-{ident}'>",
-        f"<h2>Ply {ident}: {blank.orientation:+g}°</h2>",
+        f"<h2>Ply {heading}: {blank.orientation:+g}°</h2>",
         f"<p>{html.escape(state[0])}: {state[1]}</p>",
         table(rows, ident=f"ply-table-{ident}"),
-        *(part.replace("{ply}", ident) for part in figures[drape.label]),
-        "<h3>Darts</h3>",
-        *_darts_part(drape, check, ident, units),
+        *(part.replace("{ply}", ident) for part in figures[drape.label, blank.piece]),
+        *lines,
         "</section>",
     ]
+
+
+def _splices_part(
+    drape: PlyDrapeResult, blank: PlyBlank, check: Producibility, ident: str, units: str
+) -> list[str]:
+    """A spliced ply's piece: the splices' lengths, the piece's largest shear against the
+    ply's cut whole, how much of the piece is at or beyond the locking angle."""
+    spliced = drape.spliced
+    data = spliced.summary()
+    lengths = ", ".join(number(v, 4) for v in data["splice_lengths"])
+    whole = number(data["max_shear_before"], 4)
+    state = "below" if check.max_shear < check.locking_angle else "still at or beyond"
+    text = (
+        f"The ply is cut into {len(spliced.pieces)} pieces along {data['splices']} splice(s) "
+        f"({lengths} {units} on the mould): the largest shear {whole}° cut whole, "
+        f"{number(check.max_shear, 4)}° on this piece, {state} the locking angle "
+        f"({number(check.locking_angle, 4)}°); {100 * check.fractions['limit']:.1f} % of the "
+        "piece's area is at or beyond it."
+    )
+    return [f"<p id='splices-{ident}'>{html.escape(text)}</p>"]
 
 
 def _curvature_advice(darted) -> str:
@@ -373,9 +407,11 @@ def _summary_parts(result, blanks, nest, checks, units: str) -> list[str]:
               "largest shear", "ok", "warn", "limit")  # fmt: skip
     masses = [b.mass(b.net_area, units) for b in blanks]
     total = "–" if None in masses else f"{number(sum(masses), 5)} g"
+    plies = len(result.laminate.plies)
+    pieces = f" ({len(blanks)} blanks: spliced plies in pieces)" if len(blanks) > plies else ""
     return [
         "<h2>Laminate</h2>",
-        f"<p>{len(blanks)} plies, {len(result.drapes)} distinct drapes, reference direction "
+        f"<p>{plies} plies{pieces}, {len(result.drapes)} distinct drapes, reference direction "
         f"{tuple(result.laminate.options.reference)}; areas in {units}², masses of the flat "
         "nets.</p>",
         table(_summary_rows(result, blanks, checks, units), header, ident="laminate-summary"),
@@ -398,7 +434,7 @@ def ply_book(
     """The ply book as one HTML page (module docs): ``blanks`` of :func:`~vares.structures.
     laminate_blanks.ply_blanks` (bottom first), ``nest`` of :func:`~vares.structures.
     laminate_blanks.nest_plies` or ``None``, in mesh ``units``."""
-    checks = [ply_producibility(result, b.name) for b in blanks]
+    checks = [ply_producibility(result, b.name, b.piece) for b in blanks]
     warnings = [
         f"drape {d.label} did not converge: {d.pattern.reason}"
         for d in result.drapes
@@ -410,10 +446,11 @@ def ply_book(
     parts = page(title, f"Ply book: {title}", status, warnings)
     with report_drawing():
         parts += _summary_parts(result, blanks, nest, checks, units)
-        figures: dict[str, list[str]] = {}
+        figures: dict[tuple, list[str]] = {}
         for blank, check in zip(blanks, checks, strict=True):
-            if blank.drape not in figures:
-                shear = result.drape(blank.name).blank_pattern.fields["shear_angle"]
-                figures[blank.drape] = _drape_figures(blank, shear, check, units)
+            key = (blank.drape, blank.piece)
+            if key not in figures:
+                shear = result.drape(blank.name).piece(blank.piece).pattern.fields["shear_angle"]
+                figures[key] = _drape_figures(blank, shear, check, units)
             parts += _ply_section(result, blank, check, units, figures)
     return "\n".join([*parts, "</body></html>"])

@@ -1,5 +1,7 @@
 """DXF files for the ply cutter: each ply's net and extended boundaries, its rosette and label, and
-every ply nested on the roll.
+every ply nested on the roll. A spliced ply's cutter file holds its pieces, one above the other
+across the warp (:func:`vares.structures.laminate_blanks.side_by_side`), each with its own
+boundaries, rosette and label.
 
 Coordinates are the mesh's, in its units (``$INSUNITS``), each ply in its pattern frame (warp
 along +x). Layers:
@@ -21,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..structures.laminate_blanks import PlyBlank
+from ..structures.laminate_blanks import PlyBlank, side_by_side
 from ..structures.nesting import RollNest
 from .dxf import INSUNITS, label_place
 from .files import atomic_path
@@ -36,7 +38,7 @@ def ply_label(blank: PlyBlank, units: str) -> list[str]:
     """The lines of a ply's label: name, orientation, net area and trim allowance, and the
     number of darts when it has any."""
     lines = [
-        blank.name,
+        blank.label,
         f"orientation {blank.orientation:+g} deg",
         f"net {blank.net_area:.6g} {units}2, trim +{blank.allowance:g} {units}",
     ]
@@ -99,18 +101,30 @@ def _draw(space, blank: PlyBlank, place, rotation: float, label_inside: bool, un
         top = centre + np.array([0.0, 0.5 * (len(lines) - 1) * 1.6 * height])
     else:  # below the blank, clear of every line
         height = 0.03 * size
-        top = np.array([low[0], low[1] - 2.0 * height])
+        top = place(np.array([[low[0], low[1] - 2.0 * height]]))[0]
     for row, line in enumerate(lines):
         space.add_text(line, height=height, dxfattribs={"layer": "LABEL"}).set_placement(
             tuple(top - [0.0, row * 1.6 * height])
         )
 
 
-def write_ply_dxf(path: str | Path, blank: PlyBlank, *, units: str = "mm") -> None:
+def write_ply_dxf(
+    path: str | Path, blank: PlyBlank | Sequence[PlyBlank], *, units: str = "mm"
+) -> None:
     """Write one ply's cutter file (R2010, module docs) in its pattern frame, in mesh
-    ``units``; atomically."""
+    ``units``; atomically. ``blank``: the ply's blank, or the blanks of its pieces (laid out
+    one above the other)."""
+    blanks = [blank] if isinstance(blank, PlyBlank) else list(blank)
     doc = _document(units, PLY_LAYERS)
-    _draw(doc.modelspace(), blank, lambda points: np.asarray(points), 0.0, False, units)
+    for each, shift in zip(blanks, side_by_side(blanks, gap=0.4), strict=True):
+        _draw(
+            doc.modelspace(),
+            each,
+            lambda points, shift=shift: np.asarray(points) + shift,
+            0.0,
+            False,
+            units,
+        )
     with atomic_path(Path(path)) as temporary:
         doc.saveas(temporary)
 

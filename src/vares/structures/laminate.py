@@ -19,6 +19,10 @@ A ply with darts (``darts = "auto"`` or dart lines of its own) is cut open where
 its locking angle and solved again (:func:`vares.analysis.darts.solve_with_darts`): its blank,
 cutter file and ply book are of the opened pattern, its fibre directions per mould cell are read
 back from it, and the pair check stays with the ply's pattern without darts, on the mould's cells.
+A ply with splice lines is cut into pieces along them, each draped on its own part of the mould
+(:func:`vares.analysis.splices.solve_with_splices`): each piece is a blank of its own (cut,
+nested and in the ply book), its fibre directions per mould cell are read back from the pieces,
+and the pair check stays with the ply's pattern cut whole.
 How the plies are run (here, in local processes, on a Dask scheduler) is :mod:`.laminate_tasks`.
 """
 
@@ -34,6 +38,7 @@ import numpy as np
 
 from ..analysis.darts import DartedPattern
 from ..analysis.drape import PlyDrape
+from ..analysis.splices import SplicedPly
 from ..geometry.mesh import SurfaceMesh
 from ..options import OptionsError, split_settings, takes_options
 from ..solver.result import PatternResult
@@ -42,11 +47,13 @@ from .laminate_pairs import PAIR_VALUES, PairCheck, blank_used_for, draped_yarns
 from .laminate_plies import Ply, PlyDrapeResult, darts_used
 from .laminate_regions import cell_blocks, ply_warp, region_cells, seed_on_mould, submesh
 from .laminate_tasks import (
+    cut_origin,
     dart_task,
     drape_key,
     drape_tasks,
     on_mould_cells,
     ply_locking_angle,
+    splice_task,
 )
 
 __all__ = [
@@ -221,7 +228,8 @@ def drape_laminate(
         sub, nodes = submesh(mesh, cells)
         seed_on_mould(sub, o.seed, f"ply {o.name!r}")
         darts = dart_task(ply, options, sub)
-        key = drape_key(ply, options, seed, cells, darts)
+        splices = splice_task(ply, options, sub)
+        key = drape_key(ply, options, seed, cells, darts, splices)
         ply_drape[o.name] = key
         if key in groups:
             groups[key]["plies"].append(o.name)
@@ -245,12 +253,14 @@ def drape_laminate(
             "nodes": nodes,
             "normal": normal,
             "task": {
+                "name": o.name,
                 "mesh": sub,
                 "material": ply.material,
                 "warp": warp,
                 "solve": solve_options,
                 "kinematic": kinematic,
                 "darts": darts,
+                "splices": splices,
             },
             "locking_angle": ply_locking_angle(options, o),
         }
@@ -293,8 +303,11 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         return out
 
     darted: DartedPattern | None = outcome["darted"]
+    spliced: SplicedPly | None = outcome.get("spliced")
     shear = pattern.fields["shear_angle"]
-    if darts_used(darted):  # the ply as laid: opened, read back
+    if spliced is not None:  # the ply as laid: its pieces, read back
+        warp, fill, shear = _spliced_on_mould(sub, spliced)
+    elif darts_used(darted):  # the ply as laid: opened, read back
         opened, laid = darted.slits.mesh, darted.after
         warp, fill = draped_yarns(
             opened, laid.material_coordinates, laid.fibres.warp, laid.fibres.fill
@@ -310,6 +323,13 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         )
     kinematic: PlyDrape | None = outcome["kinematic"]
     nan3 = np.full((len(cells), 3), np.nan)
+    if kinematic is not None:
+        net_warp, net_fill = kinematic.drape.warp, kinematic.drape.fill
+        net_shear = kinematic.drape.shear_angle
+        if spliced is not None and spliced.nets is not None:  # the pieces' nets, as laid
+            net_warp, net_fill, net_shear = _spliced_nets_on_mould(sub, spliced)
+    else:
+        net_warp, net_fill, net_shear = nan3, nan3, np.full(len(cells), np.nan)
     return PlyDrapeResult(
         label=group["label"],
         plies=group["plies"],
@@ -327,12 +347,52 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         shear_angle=spread(shear),
         kinematic=kinematic,
         kinematic_error=outcome["error"],
-        kinematic_warp=spread(kinematic.drape.warp if kinematic else nan3),
-        kinematic_fill=spread(kinematic.drape.fill if kinematic else nan3),
-        kinematic_shear_angle=spread(
-            kinematic.drape.shear_angle if kinematic else np.full(len(cells), np.nan)
-        ),
+        kinematic_warp=spread(net_warp),
+        kinematic_fill=spread(net_fill),
+        kinematic_shear_angle=spread(net_shear),
         seconds=outcome["seconds"],
         locking_angle=group["locking_angle"],
         darted=darted,
+        spliced=spliced,
+    )
+
+
+def _spliced_on_mould(sub: SurfaceMesh, spliced: SplicedPly) -> tuple[np.ndarray, ...]:
+    """A spliced ply's draped warp, fill ``(k, 3)`` and shear ``(k,)`` per cell of its mesh
+    ``sub``: each piece's, through the cut mesh's cells (:func:`on_mould_cells`)."""
+    cut = spliced.cut
+    warp, fill = np.zeros((cut.mesh.num_cells, 3)), np.zeros((cut.mesh.num_cells, 3))
+    for index, (piece, result) in enumerate(zip(spliced.pieces, spliced.results, strict=True)):
+        cells = cut.panel_ids == index
+        warp[cells], fill[cells] = draped_yarns(
+            piece.mesh, result.material_coordinates, result.fibres.warp, result.fibres.fill
+        )
+    return _on_mould(sub, spliced, warp, fill, spliced.cell_field("shear_angle"))
+
+
+def _spliced_nets_on_mould(sub: SurfaceMesh, spliced: SplicedPly) -> tuple[np.ndarray, ...]:
+    """The warp, fill and shear of a spliced ply's kinematic nets (one per piece) per cell of its
+    mesh ``sub``, as :func:`_spliced_on_mould`; NaN over a piece without a net."""
+    cut = spliced.cut
+    count = cut.mesh.num_cells
+    warp, fill, shear = (
+        np.full((count, 3), np.nan),
+        np.full((count, 3), np.nan),
+        np.full(count, np.nan),
+    )
+    for index, net in enumerate(spliced.nets or []):
+        if net is not None:
+            cells = cut.panel_ids == index
+            warp[cells], fill[cells] = net.drape.warp, net.drape.fill
+            shear[cells] = net.drape.shear_angle
+    return _on_mould(sub, spliced, warp, fill, shear)
+
+
+def _on_mould(sub, spliced, warp, fill, shear) -> tuple[np.ndarray, ...]:
+    origin, areas = cut_origin(sub, spliced.cut.mesh), spliced.cut.mesh.cell_areas()
+    count = sub.num_cells
+    return (
+        on_mould_cells(warp, origin, areas, count, unit=True),
+        on_mould_cells(fill, origin, areas, count, unit=True),
+        on_mould_cells(shear, origin, areas, count),
     )

@@ -11,6 +11,11 @@ comes with its warp along +x, which is the roll's direction: the plies are neste
 :func:`vares.structures.nesting.nest_pieces`.
 A darted ply's blank is its pattern opened along the darts: the darts' lips are part of its net
 boundary, and its ``darts`` are both lips of each, mouth → tip → mouth, in the pattern frame.
+A spliced ply is cut as several blanks, one per piece (in the order of the pieces, named
+``"<ply> piece-1"`` … by :attr:`PlyBlank.label`): each is nested on its own; its rosette sits at
+the pattern point of its node nearest the seed when the seed lies on it, else of its node
+nearest its centroid. :func:`side_by_side` lays a ply's pieces out in one frame (its cutter file,
+its pattern file).
 A ply's mass is that of its flat blank: the areal weight (g/m², of the undeformed fabric) times
 the pattern's area.
 """
@@ -29,7 +34,15 @@ from ..units import METRES
 from .laminate import LaminateResult
 from .nesting import RollNest, nest_pieces, usable_width
 
-__all__ = ["MITRE_LIMIT", "PlyBlank", "extended_boundary", "nest_plies", "ply_blanks", "ring_area"]
+__all__ = [
+    "MITRE_LIMIT",
+    "PlyBlank",
+    "extended_boundary",
+    "nest_plies",
+    "ply_blanks",
+    "ring_area",
+    "side_by_side",
+]
 
 
 @dataclass(frozen=True)
@@ -41,7 +54,9 @@ class PlyBlank:
     pattern point of the mould node nearest the seed); ``warp``, ``fill`` ``(2,)``: the unit yarn
     directions of the pattern; ``net_area``, ``trim_area``: flat areas; ``surface_area``: the 3D
     area of the ply on the mould; ``areal_weight`` (g/m²) and ``thickness`` (mm) when known;
-    ``darts``: the open dart lines ``(k, 2)`` (both lips, mouth → tip → mouth), none undarted.
+    ``darts``: the open dart lines ``(k, 2)`` (both lips, mouth → tip → mouth), none undarted;
+    ``piece``: the piece's name for a spliced ply (``None`` for a ply cut whole) and ``pieces``
+    how many the ply is cut into.
     """
 
     name: str
@@ -61,6 +76,13 @@ class PlyBlank:
     areal_weight: float | None
     thickness: float | None
     darts: list[np.ndarray] = field(default_factory=list)
+    piece: str | None = None
+    pieces: int = 1
+
+    @property
+    def label(self) -> str:
+        """The blank's name on the roll and in the files: the ply's, with its piece's."""
+        return self.name if self.piece is None else f"{self.name} {self.piece}"
 
     def mass(self, area: float, units: str) -> float | None:
         """Grams of fabric in ``area`` (mesh units², e.g. :attr:`net_area`) of mesh ``units``;
@@ -76,46 +98,80 @@ class PlyBlank:
 
 
 def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
-    """Every ply's blank, bottom first (module docs), with the laminate's ``trim_allowance``."""
+    """Every ply's blank, bottom first (a spliced ply's pieces in their order; module docs),
+    with the laminate's ``trim_allowance``."""
     options = result.laminate.options
     allowance = float(options.trim_allowance)
     blanks = []
-    outlines: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {}  # per drape
+    outlines: dict[tuple, tuple[list[np.ndarray], list[np.ndarray]]] = {}  # per drape and piece
     for ply in result.laminate.plies:
         drape = result.drape(ply.name)
-        mesh, pattern = drape.blank_mesh, drape.blank_pattern
-        coordinates = pattern.material_coordinates
-        if drape.label not in outlines:  # the plies of one drape share its outline
-            loops = [coordinates[loop] for loop in mesh.boundary_loops()]
-            loops.sort(key=lambda r: -abs(ring_area(r)))
-            net = [r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)]
-            outlines[drape.label] = net, extended_boundary(net, allowance)
-        net, trim = outlines[drape.label]
-        node = int(np.argmin(np.linalg.norm(mesh.points - drape.seed, axis=1)))
-        fibres = pattern.fibres
-        o = ply.options
-        blanks.append(
-            PlyBlank(
-                name=ply.name,
-                drape=drape.label,
-                orientation=float(o.orientation),
-                mesh=mesh,
-                coordinates=coordinates,
-                net=net,
-                trim=trim,
-                origin=coordinates[node].copy(),
-                warp=np.asarray(fibres.warp, dtype=float),
-                fill=np.asarray(fibres.fill, dtype=float),
-                net_area=ring_area(net[0]) + sum(ring_area(r) for r in net[1:]),
-                trim_area=ring_area(trim[0]) + sum(ring_area(r) for r in trim[1:]),
-                surface_area=float(drape.mesh.cell_areas().sum()),
-                allowance=allowance,
-                areal_weight=o.areal_weight or options.areal_weight,
-                thickness=o.thickness or options.ply_thickness,
-                darts=drape.darted.dart_pattern_lines() if drape.is_darted else [],
+        pieces = drape.pieces
+        holder = _seed_piece(pieces, drape.seed) if len(pieces) > 1 else 0
+        for index, (piece, mesh, pattern) in enumerate(pieces):
+            coordinates = pattern.material_coordinates
+            key = (drape.label, piece)
+            if key not in outlines:  # the plies of one drape share its outlines
+                loops = [coordinates[loop] for loop in mesh.boundary_loops()]
+                loops.sort(key=lambda r: -abs(ring_area(r)))
+                net = [
+                    r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)
+                ]
+                outlines[key] = net, extended_boundary(net, allowance)
+            net, trim = outlines[key]
+            target = drape.seed if index == holder else mesh.points.mean(axis=0)
+            node = int(np.argmin(np.linalg.norm(mesh.points - target, axis=1)))
+            fibres = pattern.fibres
+            o = ply.options
+            blanks.append(
+                PlyBlank(
+                    name=ply.name,
+                    drape=drape.label,
+                    orientation=float(o.orientation),
+                    mesh=mesh,
+                    coordinates=coordinates,
+                    net=net,
+                    trim=trim,
+                    origin=coordinates[node].copy(),
+                    warp=np.asarray(fibres.warp, dtype=float),
+                    fill=np.asarray(fibres.fill, dtype=float),
+                    net_area=ring_area(net[0]) + sum(ring_area(r) for r in net[1:]),
+                    trim_area=ring_area(trim[0]) + sum(ring_area(r) for r in trim[1:]),
+                    surface_area=float(mesh.cell_areas().sum()),
+                    allowance=allowance,
+                    areal_weight=o.areal_weight or options.areal_weight,
+                    thickness=o.thickness or options.ply_thickness,
+                    darts=drape.darted.dart_pattern_lines() if drape.is_darted else [],
+                    piece=piece,
+                    pieces=len(pieces),
+                )
             )
-        )
     return blanks
+
+
+def _seed_piece(pieces, seed: np.ndarray) -> int:
+    """The index of the piece whose surface lies nearest the seed (the one it lies on)."""
+    from ..geometry.surface_points import FaceLocator
+
+    distance = [
+        float(np.linalg.norm(FaceLocator(p.mesh).locate(seed)[2][0] - seed)) for p in pieces
+    ]
+    return int(np.argmin(distance))
+
+
+def side_by_side(blanks: Sequence[PlyBlank], gap: float = 0.4) -> list[np.ndarray]:
+    """Shifts ``(2,)`` that lay ``blanks`` (a ply's pieces) out one above the other across the
+    warp (along +y), ``gap`` times the largest blank's size apart (room for a label below
+    each), the first where it is."""
+    if not blanks:
+        return []
+    size = max(float(np.ptp(b.trim[0], axis=0).max()) for b in blanks)
+    shifts, top = [np.zeros(2)], float(blanks[0].trim[0][:, 1].max())
+    for blank in blanks[1:]:
+        low = float(blank.trim[0][:, 1].min())
+        shifts.append(np.array([0.0, top + gap * size - low]))
+        top = float(blank.trim[0][:, 1].max()) + shifts[-1][1]
+    return shifts
 
 
 def nest_plies(
@@ -128,7 +184,7 @@ def nest_plies(
     for blank in blanks:
         if blank.width > widest:
             raise ValueError(
-                f"ply {blank.name} is {blank.width:.6g} wide across its warp (with the trim "
+                f"ply {blank.label} is {blank.width:.6g} wide across its warp (with the trim "
                 f"allowance); a roll_width of {roll_width:g} takes at most {widest:.6g}"
             )
     return nest_pieces(

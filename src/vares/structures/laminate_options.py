@@ -160,8 +160,8 @@ class LaminateOptions(Options):
 
 @dataclass(frozen=True)
 class PlyOptions(Options):
-    """One ply of a laminate: its name, fabric, orientation, seed, region, drop-off order and
-    darts."""
+    """One ply of a laminate: its name, fabric, orientation, seed, region, drop-off order,
+    darts and splices."""
 
     title = "ply option"
 
@@ -250,6 +250,14 @@ class PlyOptions(Options):
         help="Dart lines of the ply's own: a curves file (points 'x y z', a blank line between two "
         "lines, or a 3dm file), each from the ply's boundary into it; opened as they are.",
     )
+    splice_lines: str | None = reused(
+        DartOptions,
+        "splice_lines",
+        section="ply",
+        help="Splice lines of the ply: a curves file (as dart_lines), each from the ply's boundary "
+        "across it to the boundary; the ply is cut into pieces along them, each draped, cut and "
+        "nested on its own (where darts cannot relieve the shear: negatively curved moulds).",
+    )
     locking_angle: float | None = reused(
         DrapeOptions,
         "locking_angle",
@@ -267,6 +275,8 @@ class PlyOptions(Options):
             raise OptionsError("region_value", "needs a region field")
         if self.darts == "auto" and self.dart_lines is not None:
             raise OptionsError(None, "give a ply darts = 'auto' or dart_lines, not both")
+        if self.splice_lines is not None and (self.darts == "auto" or self.dart_lines is not None):
+            raise OptionsError(None, "give a ply darts or splice_lines, not both")
         if self.locking_angle is not None and self.locking_angle > 90.0:
             raise OptionsError(
                 "locking_angle", f"must be at most 90 degrees; got {self.locking_angle}"

@@ -6,7 +6,7 @@ check (:mod:`.laminate_pairs`) take them without importing the laminate (:mod:`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -14,21 +14,33 @@ from ..analysis.darts import DartedPattern
 from ..analysis.drape import PlyDrape
 from ..geometry.mesh import SurfaceMesh
 from ..materials import Hyperelastic
+from ..options import OptionsError
 from ..solver.result import PatternResult
 from .laminate_options import PlyOptions
 
-__all__ = ["Ply", "PlyDrapeResult", "darts_used"]
+if TYPE_CHECKING:
+    from ..analysis.splices import SplicedPly
+
+__all__ = ["BlankPiece", "Ply", "PlyDrapeResult", "darts_used"]
 
 
 @dataclass(frozen=True)
 class Ply:
-    """A ply: its :class:`PlyOptions`, its material (a hyperelastic law, thickness 1) and the
+    """A ply: its :class:`PlyOptions`, its material (a hyperelastic law, thickness 1), the
     dart lines of its own (``(k, 3)`` polylines on or near the mould, mouth or tip first; e.g.
-    the curves of its ``dart_lines`` file), if any."""
+    the curves of its ``dart_lines`` file), if any, and its splice lines (``(k, 3)`` polylines
+    from its boundary across it to the boundary; its ``splice_lines`` file's), if any."""
 
     options: PlyOptions
     material: Hyperelastic
     dart_lines: tuple[np.ndarray, ...] | None = None
+    splice_lines: tuple[np.ndarray, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.splice_lines is not None and (
+            self.dart_lines is not None or self.options.darts == "auto"
+        ):
+            raise OptionsError(None, f"ply {self.name}: give darts or splice lines, not both")
 
     @property
     def name(self) -> str:
@@ -39,6 +51,15 @@ def darts_used(darted: DartedPattern | None) -> bool:
     """Whether a ply is cut with the darts of ``darted``
     (:attr:`~vares.analysis.darts.DartedPattern.kept`)."""
     return darted is not None and darted.kept
+
+
+class BlankPiece(NamedTuple):
+    """One piece of a ply as cut: ``piece`` its name (``None`` for a ply cut whole, else
+    ``"piece-1"`` …), ``mesh`` its cells on the mould and ``pattern`` its flat pattern."""
+
+    piece: str | None
+    mesh: SurfaceMesh
+    pattern: PatternResult
 
 
 @dataclass
@@ -52,13 +73,15 @@ class PlyDrapeResult:
     ``kinematic``: the pin-jointed net beside it (``None`` when not asked for or failed, with
     ``kinematic_error``). ``darted``: the ply with its darts open (``None`` without darts asked
     for; its ``after`` is ``None`` when none was needed or placed; the ply is cut with them when
-    :attr:`is_darted`) and ``locking_angle`` (degrees).
+    :attr:`is_darted`) and ``locking_angle`` (degrees). ``spliced``: the ply cut into pieces
+    along its splice lines and each piece's pattern (``None`` without splice lines).
     Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``, ``fill`` (unit erected
     yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
-    laid (the darted pattern's, each mould cell the area-weighted mean of its pieces in the
-    opened mesh: :func:`~vares.structures.laminate_tasks.on_mould_cells`), and the kinematic
+    laid (the darted or spliced patterns', each mould cell the area-weighted mean of its pieces
+    in the opened or cut mesh: :func:`~vares.structures.laminate_tasks.on_mould_cells`), and the
+    kinematic
     ``kinematic_warp``, ``kinematic_fill``, ``kinematic_shear_angle``. The pair check uses
-    ``pattern``, the ply without darts, on the mould's cells.
+    ``pattern``, the ply without darts or splices, on the mould's cells.
     """
 
     label: str
@@ -83,6 +106,27 @@ class PlyDrapeResult:
     seconds: float
     locking_angle: float = float("nan")
     darted: DartedPattern | None = None
+    spliced: SplicedPly | None = None
+
+    @property
+    def is_spliced(self) -> bool:
+        """Whether the ply is cut into pieces along splice lines."""
+        return self.spliced is not None
+
+    @property
+    def pieces(self) -> list[BlankPiece]:
+        """The ply as cut: its pieces along the splice lines, else its one blank
+        (:attr:`blank_mesh`, :attr:`blank_pattern`)."""
+        if self.spliced is not None:
+            return [
+                BlankPiece(piece.name, piece.mesh, result)
+                for piece, result in zip(self.spliced.pieces, self.spliced.results, strict=True)
+            ]
+        return [BlankPiece(None, self.blank_mesh, self.blank_pattern)]
+
+    def piece(self, name: str | None) -> BlankPiece:
+        """The piece named ``name`` of :attr:`pieces` (``None``: the ply cut whole)."""
+        return next(p for p in self.pieces if p.piece == name)
 
     @property
     def is_darted(self) -> bool:
@@ -92,7 +136,8 @@ class PlyDrapeResult:
 
     @property
     def blank_mesh(self) -> SurfaceMesh:
-        """The mesh of the blank as cut: the ply's mesh opened along its darts, if any."""
+        """The mesh of the blank as cut: the ply's mesh opened along its darts, if any (a
+        spliced ply's pieces are :attr:`pieces`)."""
         return self.darted.slits.mesh if self.is_darted else self.mesh
 
     @property
@@ -102,7 +147,7 @@ class PlyDrapeResult:
 
     @property
     def converged(self) -> bool:
-        return bool(self.pattern.converged and self.blank_pattern.converged)
+        return bool(self.pattern.converged and all(p.pattern.converged for p in self.pieces))
 
     def summary(self) -> dict[str, Any]:
         """The numbers for a summary file."""
@@ -133,4 +178,5 @@ class PlyDrapeResult:
             data["kinematic_drape"] = {"error": self.kinematic_error}
         data["locking_angle"] = self.locking_angle
         data["darts"] = None if self.darted is None else self.darted.summary()
+        data["splices"] = None if self.spliced is None else self.spliced.summary()
         return data

@@ -12,12 +12,19 @@ has more cells than the ply's. Each of its cells lies in one cell of the ply's m
 triangle. A ply is cut with its darts only when they lower its largest shear
 (:func:`~vares.structures.laminate_plies.darts_used`): darts that leave it as high or higher
 (the rib's, docs/composites.md) are reported, and the ply is cut whole.
+
+A ply with splice lines is solved by :func:`vares.analysis.splices.solve_with_splices`: the
+pattern of the ply's mesh (the pair check's), then the mesh cut into pieces along the lines and
+every piece's pattern; with the kinematic net, every piece gets its own too (from its node
+nearest its centroid), beside the whole ply's. The cut splits the cells the lines cross, too;
+each cut cell lies in one cell of the ply's mesh (:func:`cut_origin`).
 :func:`on_mould_cells` gives every cell of the ply's mesh the area-weighted mean of its pieces
 (unit vectors normalised again), which is the piece's own value where the cell is whole.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import time
 from collections.abc import Sequence
@@ -27,7 +34,9 @@ import numpy as np
 
 from ..analysis.darts import solve_with_darts
 from ..analysis.drape import drape_ply
+from ..analysis.splices import solve_with_splices
 from ..geometry.mesh import SurfaceMesh
+from ..geometry.surface_lines import CuttingError
 from ..materials.forming import locking_angle
 from ..options import OptionsError
 from ..parallel import parallel_map
@@ -36,6 +45,7 @@ from .laminate_options import LaminateOptions, PlyOptions
 from .laminate_plies import Ply, darts_used
 
 __all__ = [
+    "cut_origin",
     "dart_task",
     "darts_used",
     "drape_key",
@@ -43,15 +53,18 @@ __all__ = [
     "drape_tasks",
     "on_mould_cells",
     "ply_locking_angle",
+    "splice_task",
 ]
 
 
 def drape_task(task: dict[str, Any]) -> dict[str, Any]:
     """Drape one distinct ply (in any process): the pattern of its mesh, with its darts when
     asked (``task["darts"]``: ``None``, or the keywords of the locking angle, the dart mode and
-    given lines), and the kinematic net beside it (its failure is reported, not raised). Plies
-    may be draped in several threads of one process at once (a Dask worker's threads): each
-    thread solves with its own linear solver (:class:`vares.solver.linear.PardisoState`)."""
+    given lines) or its pieces along splice lines (``task["splices"]``: ``None``, or the locking
+    angle and the lines), and the kinematic net beside it (its failure is reported, not raised;
+    a spliced ply's pieces each get one too). Plies may be draped in several threads of one
+    process at once (a Dask worker's threads): each thread solves with its own linear solver
+    (:class:`vares.solver.linear.PardisoState`)."""
     return _drape(task)
 
 
@@ -59,34 +72,58 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
     started = time.perf_counter()
     mesh = task["mesh"]
     settings = {**task["solve"], "warp_direction": tuple(task["warp"])}
-    darted = None
-    if task["darts"] is None:
-        pattern = solve(mesh, task["material"], 1.0, **settings)
-    else:
-        darts = task["darts"]
-        darted = solve_with_darts(
-            mesh,
-            task["material"],
-            1.0,
-            locking_angle=darts["locking_angle"],
-            polylines=darts["polylines"],
-            darts=darts["mode"],
-            **settings,
-        )
-        pattern = darted.before
+    darted = spliced = None
+    try:
+        if task.get("splices") is not None:
+            spliced = solve_with_splices(
+                mesh,
+                task["material"],
+                1.0,
+                locking_angle=task["splices"]["locking_angle"],
+                polylines=task["splices"]["polylines"],
+                **settings,
+            )
+            pattern = spliced.before
+        elif task["darts"] is None:
+            pattern = solve(mesh, task["material"], 1.0, **settings)
+        else:
+            darts = task["darts"]
+            darted = solve_with_darts(
+                mesh,
+                task["material"],
+                1.0,
+                locking_angle=darts["locking_angle"],
+                polylines=darts["polylines"],
+                darts=darts["mode"],
+                **settings,
+            )
+            pattern = darted.before
+    except CuttingError as exc:  # a ply's darts or splices: which ply's
+        raise CuttingError(f"ply {task.get('name', '?')}: {exc}") from None
     kinematic, error = None, None
     if task["kinematic"] is not None:
-        try:
-            kinematic = drape_ply(mesh, **task["kinematic"])
-        except Exception as exc:  # the net is beside the pattern: its failure is reported
-            error = f"{type(exc).__name__}: {exc}"
+        kinematic, error = _net(mesh, task["kinematic"])
+        if spliced is not None:  # every piece's own net, from its node nearest its centroid
+            own = {**task["kinematic"], "seed": None}
+            nets, errors = zip(*(_net(piece.mesh, own) for piece in spliced.pieces), strict=True)
+            spliced = dataclasses.replace(spliced, nets=list(nets), net_errors=list(errors))
     return {
         "pattern": pattern,
         "darted": darted,
+        "spliced": spliced,
         "kinematic": kinematic,
         "error": error,
         "seconds": time.perf_counter() - started,
     }
+
+
+def _net(mesh: SurfaceMesh, settings: dict[str, Any]) -> tuple[Any, str | None]:
+    """The kinematic net on ``mesh`` and None, or None and why it failed (the net is beside the
+    pattern: its failure is reported)."""
+    try:
+        return drape_ply(mesh, **settings), None
+    except Exception as exc:
+        return None, f"{type(exc).__name__}: {exc}"
 
 
 def drape_tasks(
@@ -127,10 +164,37 @@ def ply_locking_angle(options: LaminateOptions, ply: PlyOptions) -> float:
     return float(locking_angle(ply.fabric_kind or options.fabric_kind))
 
 
+def cut_origin(mesh: SurfaceMesh, cut: SurfaceMesh) -> np.ndarray:
+    """The cell of the triangle mesh ``mesh`` ``(k,)`` that each cell of ``cut`` lies in:
+    ``cut`` is ``mesh`` with lines cut into it (every cell of it a part of one of ``mesh``'s,
+    so its centroid lies inside that cell)."""
+    from ..geometry.surface_points import FaceLocator
+
+    centroids = np.concatenate([cut.points[c].mean(axis=1) for c in cut.cells.values()])
+    return FaceLocator(mesh).locate(centroids)[0]
+
+
+def splice_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str, Any] | None:
+    """What the ply's splices need in its task, or ``None`` without splice lines."""
+    if ply.splice_lines is None:
+        if ply.options.splice_lines is not None:
+            raise OptionsError(
+                "splice_lines", f"ply {ply.name}: pass the file's lines as splice_lines"
+            )
+        return None
+    if set(mesh.cells) != {"triangle"}:
+        raise OptionsError("splice_lines", f"ply {ply.name}: splices need a mould of triangles")
+    return {
+        "locking_angle": ply_locking_angle(options, ply.options),
+        "polylines": [np.asarray(p, float) for p in ply.splice_lines],
+    }
+
+
 def dart_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str, Any] | None:
-    """What the ply's darts need in its task, or ``None`` without darts."""
+    """What the ply's darts need in its task, or ``None`` without darts (a spliced ply has
+    none: its pieces relieve it)."""
     mode = ply.options.darts or options.darts
-    if ply.dart_lines is None and mode == "none":
+    if ply.dart_lines is None and (mode == "none" or ply.splice_lines is not None):
         return None
     if ply.options.dart_lines is not None and ply.dart_lines is None:
         raise OptionsError("dart_lines", f"ply {ply.name}: pass the file's lines as dart_lines")
@@ -144,20 +208,33 @@ def dart_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str
     }
 
 
+def _digested(lines: dict | None) -> tuple | None:
+    """A darts' or splices' task entry as a key: its polylines by their digest."""
+    if lines is None:
+        return None
+    if lines["polylines"] is not None:
+        digest = hashlib.sha1(
+            b"".join(np.ascontiguousarray(p).tobytes() for p in lines["polylines"])
+        )
+        lines = {**lines, "polylines": digest.hexdigest()}
+    return tuple(sorted(lines.items()))
+
+
 def drape_key(
-    ply: Ply, options: LaminateOptions, seed: np.ndarray, cells: np.ndarray, darts: dict | None
+    ply: Ply,
+    options: LaminateOptions,
+    seed: np.ndarray,
+    cells: np.ndarray,
+    darts: dict | None,
+    splices: dict | None = None,
 ) -> tuple:
     """What makes two plies one drape: orientation, material, seed, fabric kind, locking
-    angle (both as the ply takes them, its own or the laminate's), cells and darts (the plies
-    of a symmetric stack's halves share it)."""
+    angle (both as the ply takes them, its own or the laminate's), cells, darts and splices
+    (the plies of a symmetric stack's halves share it)."""
     o = ply.options
-    if darts is not None and darts["polylines"] is not None:
-        digest = hashlib.sha1(
-            b"".join(np.ascontiguousarray(p).tobytes() for p in darts["polylines"])
-        )
-        darts = {**darts, "polylines": digest.hexdigest()}
     return (
-        None if darts is None else tuple(sorted(darts.items())),
+        _digested(darts),
+        _digested(splices),
         round(float(o.orientation) % 360.0, 9),
         repr(ply.material.parameters) + type(ply.material).__name__,
         tuple(np.round(seed, 12)),

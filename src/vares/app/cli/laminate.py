@@ -39,9 +39,10 @@ def laminate(
     Writes laminate.json, laminate.md (the pair matrices), laminate.vtu (the draped warp and
     fill per cell and ply), orientations.inp (Abaqus, one *ORIENTATION per ply),
     orientations.csv, patterns/drape_ANGLEdeg.vtu, plybook.html (the ply book), plies/PLY.dxf
-    (each ply's cutter file, its darts on layer DART) and, with a roll_width, nest.dxf (every
-    ply nested on the roll) into the output directory. --workers, --scheduler and --darts
-    replace the values of the job's laminate table. Exit status 1 when a ply did not converge.
+    (each ply's cutter file, its darts on layer DART, a spliced ply's pieces side by side)
+    and, with a roll_width, nest.dxf (every blank nested on the roll) into the output
+    directory. --workers, --scheduler and --darts replace the values of the job's laminate
+    table. Exit status 1 when a ply did not converge.
     """
 
     def body() -> None:
@@ -64,6 +65,12 @@ def laminate(
                         f", {len(drape.darted.dart_lines)} dart(s): largest shear "
                         f"{drape.darted.max_shear_before:.2f}° -> "
                         f"{drape.darted.max_shear_after:.2f}°"
+                    )
+                elif drape.is_spliced:
+                    dart_text = (
+                        f", {len(drape.spliced.pieces)} pieces: largest shear "
+                        f"{drape.spliced.max_shear_before:.2f}° -> "
+                        f"{drape.spliced.max_shear_after:.2f}°"
                     )
                 console.print(
                     f"  {drape.label} ({', '.join(drape.plies)}): {state}, "
@@ -116,7 +123,7 @@ def _show_cutting(run) -> None:
     for blank in run.blanks:
         mass = blank.mass(blank.net_area, units)
         table.add_row(
-            blank.name,
+            blank.label,
             f"{blank.orientation:+g}°",
             f"{blank.net_area:.6g}",
             f"{blank.trim_area:.6g}",
@@ -126,7 +133,7 @@ def _show_cutting(run) -> None:
     nest = run.nest
     if nest is not None:
         console.print(
-            f"nest: {len(nest.pieces)} plies on a roll {nest.roll_width:g} {units} wide, "
+            f"nest: {len(nest.pieces)} blanks on a roll {nest.roll_width:g} {units} wide, "
             f"{nest.length:.6g} {units} long, yield {100 * nest.yield_:.1f} % "
             f"({nest.elapsed:.1f} s)"
         )

@@ -1,0 +1,288 @@
+"""Splices in the plies of a laminate: a ply cut into pieces along lines across it, each piece
+draped, cut, nested and booked on its own, its fibre directions read back per mould cell."""
+
+import itertools
+import json
+import re
+
+import ezdxf
+import meshio
+import numpy as np
+import pytest
+from conftest import run
+from test_laminate_cutting import chromium
+from test_laminate_darts import JOB, parse
+
+from vares.analysis.darts import erected_yarns
+from vares.app.job import JobError
+from vares.app.laminate_outputs import orientation_tables
+from vares.app.ply_book import ply_book
+from vares.geometry.examples import cap_over_square
+from vares.geometry.mesh import SurfaceMesh
+from vares.geometry.surface_lines import CuttingError
+from vares.io.meshes import write_surface
+from vares.io.ply_dxf import write_ply_dxf, write_ply_nest_dxf
+from vares.materials import NonCrimpFabric
+from vares.options import OptionsError
+from vares.structures.laminate import Ply, PlyOptions, drape_laminate
+from vares.structures.laminate_blanks import nest_plies, ply_blanks, side_by_side
+from vares.structures.laminate_tasks import cut_origin
+
+NCF = NonCrimpFabric.from_moduli(1000.0, 1000.0, 1.0)
+RADIUS = 12.0
+
+
+def mould():
+    """A spherical cap of radius 12 over the square [-5, 5]², 200 triangles."""
+    return cap_over_square(10.0, RADIUS, 10)
+
+
+def across(x=None, y=None, reach=4.999):
+    """A line on the cap from its boundary to its boundary: along y at ``x``, or along x at
+    ``y``; off the grid's lines, so that it cuts cells."""
+    t = np.linspace(-reach, reach, 60)
+    xs, ys = (np.full_like(t, x), t) if x is not None else (t, np.full_like(t, y))
+    z = np.sqrt(RADIUS**2 - xs**2 - ys**2) - np.sqrt(RADIUS**2 - 50.0)
+    return np.column_stack([xs, ys, z])
+
+
+SPLICES = (across(x=0.37), across(y=-0.41))
+
+
+def plies(splices=SPLICES):
+    return [
+        Ply(PlyOptions(name="A", orientation=0.0), NCF, splice_lines=splices),
+        Ply(PlyOptions(name="B", orientation=45.0), NCF),
+    ]
+
+
+@pytest.fixture(scope="module")
+def plain():
+    return drape_laminate(mould(), plies(None), workers=1, kinematic=True, trim_allowance=0.5)
+
+
+@pytest.fixture(scope="module")
+def spliced():
+    return drape_laminate(mould(), plies(), workers=1, kinematic=True, trim_allowance=0.5)
+
+
+def test_a_spliced_ply_is_four_pieces_and_the_other_ply_is_untouched(plain, spliced):
+    a, b = spliced.drape("A"), spliced.drape("B")
+    assert spliced.converged and a.is_spliced and not b.is_spliced
+    assert [p.piece for p in a.pieces] == [f"piece-{k}" for k in range(1, 5)]
+    assert [p.piece for p in b.pieces] == [None]
+    # the whole ply is the pattern of the laminate without splices (the pair check's)
+    np.testing.assert_array_equal(
+        a.pattern.material_coordinates, plain.drape("A").pattern.material_coordinates
+    )
+    np.testing.assert_array_equal(b.warp, plain.drape("B").warp)
+    for value in ("warp_compressed_fraction", "largest_compression", "mean_deviation"):
+        np.testing.assert_array_equal(spliced.pair_matrix(value), plain.pair_matrix(value))
+    # the pieces drape with less shear than the whole ply (8.2° on this cap)
+    before, after = a.spliced.max_shear_before, a.spliced.max_shear_after
+    assert before == pytest.approx(plain.drape("A").summary()["max_shear"])
+    assert after < 0.5 * before
+    summary = a.summary()
+    assert summary["max_shear"] == pytest.approx(after)
+    assert summary["splices"]["pieces"][0]["name"] == "piece-1"
+
+
+def test_the_pieces_cells_lie_in_the_mould_cells_and_make_up_their_areas(spliced):
+    a = spliced.drape("A")
+    cut = a.spliced.cut
+    origin = cut_origin(a.mesh, cut.mesh)
+    count = np.bincount(origin, minlength=a.mesh.num_cells)
+    assert count.min() == 1 and count.max() > 1  # the lines cut cells
+    np.testing.assert_allclose(
+        np.bincount(origin, cut.mesh.cell_areas(), a.mesh.num_cells), a.mesh.cell_areas(), rtol=1e-9
+    )
+    # every piece's cells are those of the cut mesh it is made of, in their order
+    for index, piece in enumerate(a.spliced.pieces):
+        cells = np.flatnonzero(cut.panel_ids == index)
+        np.testing.assert_allclose(
+            piece.mesh.cell_areas(), cut.mesh.cell_areas()[cells], rtol=1e-12
+        )
+
+
+def test_orientations_of_a_spliced_ply_are_its_pieces_per_mould_cell(spliced):
+    """One row per mould cell: a whole cell's directions and shear are those of its piece's
+    pattern, a split cell's the area-weighted mean of its parts' (normalised)."""
+    a = spliced.drape("A")
+    (table,) = [t for t in orientation_tables(spliced) if t.name == "A"]
+    np.testing.assert_array_equal(table.elements, np.arange(1, spliced.mesh.num_cells + 1))
+    cut = a.spliced.cut
+    warp = np.zeros((cut.mesh.num_cells, 3))
+    for index, (piece, result) in enumerate(zip(a.spliced.pieces, a.spliced.results, strict=False)):
+        cells = cut.panel_ids == index
+        warp[cells] = erected_yarns(
+            piece.mesh, result.material_coordinates, result.fibres.warp, result.fibres.fill
+        )[0]
+    shear = a.spliced.cell_field("shear_angle")
+    origin, areas = cut_origin(a.mesh, cut.mesh), cut.mesh.cell_areas()
+    count = np.bincount(origin, minlength=a.mesh.num_cells)
+    whole = np.flatnonzero(count[origin] == 1)
+    np.testing.assert_allclose(table.warp[origin[whole]], warp[whole], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(table.shear_angle[origin[whole]], shear[whole], atol=1e-12)
+    for cell in np.flatnonzero(count > 1):
+        parts = origin == cell
+        mean = areas[parts] @ warp[parts]
+        np.testing.assert_allclose(table.warp[cell], mean / np.linalg.norm(mean), atol=1e-12)
+        np.testing.assert_allclose(
+            table.shear_angle[cell], areas[parts] @ shear[parts] / areas[parts].sum(), atol=1e-12
+        )
+
+
+def test_every_piece_has_its_own_kinematic_net(plain, spliced):
+    a = spliced.drape("A")
+    nets = a.spliced.nets
+    assert nets is not None and all(n is not None for n in nets)
+    cut = a.spliced.cut
+    origin = cut_origin(a.mesh, cut.mesh)
+    count = np.bincount(origin, minlength=a.mesh.num_cells)
+    for index, net in enumerate(nets):
+        cells = np.flatnonzero(cut.panel_ids == index)
+        whole = cells[count[origin[cells]] == 1]
+        shear = net.drape.shear_angle[np.searchsorted(cells, whole)]
+        np.testing.assert_allclose(a.kinematic_shear_angle[origin[whole]], shear, atol=1e-12)
+    # each net seeded on its own piece shears less than the whole ply's
+    whole_net = np.nanmax(np.abs(plain.drape("A").kinematic_shear_angle))
+    assert np.nanmax(np.abs(a.kinematic_shear_angle)) < whole_net
+    # the whole ply's net stays beside the whole pattern
+    assert a.kinematic is not None
+    ours, whole = a.summary()["kinematic_drape"], plain.drape("A").summary()["kinematic_drape"]
+    assert ours["producibility"] == whole["producibility"]
+    assert ours["against_pattern"] == whole["against_pattern"]
+
+
+def test_each_piece_is_a_blank_and_all_are_nested(spliced, tmp_path):
+    blanks = ply_blanks(spliced)
+    assert [b.label for b in blanks] == [f"A piece-{k}" for k in range(1, 5)] + ["B"]
+    pieces = blanks[:4]
+    assert all(b.pieces == 4 for b in pieces) and blanks[4].pieces == 1
+    # the pieces cover the mould: their areas on it add up to the ply's
+    total = sum(b.surface_area for b in pieces)
+    assert total == pytest.approx(spliced.mesh.cell_areas().sum(), rel=1e-12)
+    for blank, piece in zip(pieces, spliced.drape("A").pieces, strict=False):
+        assert blank.mesh is piece.mesh
+        assert blank.net_area == pytest.approx(piece.pattern.fields["pattern_area"].sum(), 1e-9)
+        assert blank.trim_area > blank.net_area
+    # the piece the seed (the mould's node nearest its centroid) lies on holds it; the others
+    # have their rosettes at their own middles, each inside its blank
+    from shapely.geometry import Point, Polygon
+
+    for blank in pieces:
+        assert Polygon(blank.net[0]).buffer(1e-9).contains(Point(blank.origin))
+    nest = nest_plies(blanks, 30.0, time_limit=1.0)
+    assert sorted(p.index for p in nest.pieces) == list(range(5))
+    write_ply_nest_dxf(tmp_path / "nest.dxf", blanks, nest, units="mm")
+    space = ezdxf.readfile(tmp_path / "nest.dxf").modelspace()
+    assert len([e for e in space if e.dxf.layer == "NET"]) == 5
+    labels = [e.dxf.text for e in space if e.dxf.layer == "LABEL"]
+    assert sum(text == "A piece-3" for text in labels) == 1
+
+
+def test_a_spliced_plys_cutter_file_holds_its_pieces_side_by_side(spliced, tmp_path):
+    pieces = [b for b in ply_blanks(spliced) if b.name == "A"]
+    write_ply_dxf(tmp_path / "A.dxf", pieces, units="mm")
+    space = ezdxf.readfile(tmp_path / "A.dxf").modelspace()
+    nets = [np.array([p[:2] for p in e.get_points()]) for e in space if e.dxf.layer == "NET"]
+    shifts = side_by_side(pieces)
+    assert len(nets) == 4
+    for drawn, blank, shift in zip(nets, pieces, shifts, strict=False):
+        np.testing.assert_allclose(drawn, blank.net[0] + shift, atol=1e-9)
+    # laid out without overlap: each piece's trim line clear of the next one's
+    from shapely.geometry import Polygon
+
+    trims = [Polygon(b.trim[0] + s) for b, s in zip(pieces, shifts, strict=False)]
+    assert all(not p.intersects(q) for p, q in itertools.pairwise(trims))
+
+
+def test_the_ply_book_has_a_section_per_piece(spliced):
+    blanks = ply_blanks(spliced)
+    text = ply_book(spliced, blanks, None, units="mm")
+    a = spliced.drape("A").spliced
+    for k in range(1, 5):
+        section = text.split(f"id='ply-A-piece-{k}'")[1].split("</section>")[0]
+        assert f"Ply A, piece-{k} of 4" in section
+        assert "<h3>Splices</h3>" in section
+        assert f"{a.max_shear_before:.4g}°" in section
+    assert "id='ply-B'" in text
+
+
+def write_curves(path, lines):
+    text = "\n\n".join("\n".join(" ".join(f"{v:.17g}" for v in p) for p in line)
+                       for line in lines)  # fmt: skip
+    path.write_text(text + "\n", encoding="utf-8")
+
+
+def test_cli_cuts_a_spliced_ply_into_pieces(tmp_path):
+    write_surface(tmp_path / "mould.obj", mould())
+    write_curves(tmp_path / "splices.txt", SPLICES)
+    job = JOB.replace(
+        "kinematic = false", "trim_allowance = 0.5\nroll_width = 30.0\nnest_time = 1.0"
+    )
+    job += '\n[[ply]]\nname = "A"\nsplice_lines = "splices.txt"\n'
+    job += '\n[[ply]]\nname = "B"\norientation = 45.0\n'
+    (tmp_path / "job.toml").write_text(job, encoding="utf-8")
+    result = run("laminate", tmp_path / "job.toml")
+    assert result.exit_code == 0, result.stderr
+    assert re.search(r"4 pieces: largest shear 8\.\d\d° -> [0-4]\.\d\d°", result.stderr)
+    assert "nest: 5 blanks on a roll" in result.stderr
+    out = tmp_path / "out"
+    summary = json.loads((out / "laminate.json").read_text(encoding="utf-8"))
+    pieces = [b["piece"] for b in summary["blanks"]]
+    assert pieces == ["piece-1", "piece-2", "piece-3", "piece-4", None]
+    assert summary["drapes"][0]["splices"]["splices"] >= 2
+    assert len(summary["nest"]["pieces"]) == 5
+    # the flat pieces in one pattern file, each cell's piece named
+    flat = meshio.read(out / "patterns" / "drape_0deg.vtu")
+    number = np.concatenate(flat.cell_data["piece"])
+    cut = sum(p["cells"] for p in summary["drapes"][0]["splices"]["pieces"])
+    assert len(number) == cut > mould().num_cells
+    assert sorted(np.unique(number)) == [1, 2, 3, 4]
+    assert np.ptp(flat.points[:, 2]) == 0.0
+    # the cutter file: the four pieces
+    space = ezdxf.readfile(out / "plies" / "A.dxf").modelspace()
+    assert len([e for e in space if e.dxf.layer == "NET"]) == 4
+    # the orientation table: one row per mould cell
+    inp = (out / "orientations.inp").read_text(encoding="utf-8")
+    assert inp.count("*ORIENTATION, NAME=") == 2
+    csv = (out / "orientations.csv").read_text(encoding="utf-8").splitlines()
+    assert sum(line.split(",")[1] == "A" for line in csv[1:]) == mould().num_cells
+    # the ply book as Chromium reads it: a section per piece, with its pictures
+    dom = chromium(tmp_path, "--dump-dom", (out / "plybook.html").as_uri()).stdout
+    for k in range(1, 5):
+        section = dom.split(f'id="ply-A-piece-{k}"')[1].split("</section>")[0]
+        assert f'id="splices-A-piece-{k}"' in section
+        for kind in ("blank", "shear", "producibility"):
+            assert f'id="figure-A-piece-{k}-{kind}"' in section
+
+
+def test_splice_options_are_checked(tmp_path):
+    ply = '\n[[ply]]\nname = "A"\n'
+    job = parse(JOB + ply + 'splice_lines = "s.txt"\n')
+    assert job.plies[0].splice_lines == "s.txt"
+    with pytest.raises(JobError, match="darts or splice_lines, not both"):
+        parse(JOB + ply + 'splice_lines = "s.txt"\ndarts = "auto"\n')
+    with pytest.raises(JobError, match="darts or splice_lines, not both"):
+        parse(JOB + ply + 'splice_lines = "s.txt"\ndart_lines = "d.txt"\n')
+    with pytest.raises(OptionsError, match="darts or splice lines, not both"):
+        Ply(PlyOptions(name="A", darts="auto"), NCF, splice_lines=SPLICES)
+    # a missing file, named with its ply and key
+    write_surface(tmp_path / "mould.obj", mould())
+    (tmp_path / "job.toml").write_text(JOB + ply + 'splice_lines = "none.txt"\n', "utf-8")
+    result = run("laminate", tmp_path / "job.toml")
+    assert result.exit_code == 2, result.stderr
+    assert "[[ply]] A splice_lines:" in result.stderr and "none.txt" in result.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_splices_that_cannot_be_cut_are_refused_with_the_ply_named():
+    with pytest.raises(CuttingError, match=r"ply A: .*away from the surface's boundary"):
+        drape_laminate(mould(), plies((across(x=0.37, reach=2.0),)), workers=1, kinematic=False)
+    quads = SurfaceMesh(
+        np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0.2], [2, 1, 0]], float),
+        {"quad": np.array([[0, 1, 4, 3], [1, 2, 5, 4]])},
+    )
+    with pytest.raises(OptionsError, match="splices need a mould of triangles"):
+        drape_laminate(quads, plies()[:1], kinematic=False)
