@@ -78,7 +78,8 @@ class SplicedPly:
     chains); ``pieces``: the pieces (named ``piece-1`` …, in the order of ``cut.panel_ids``) and
     ``results`` their patterns; ``locking_angle`` in degrees; ``seconds``: the pieces' solves;
     ``nets``: the kinematic drape of every piece (:func:`drape_pieces`), or None;
-    ``net_errors``: why a piece has no net (None where it has one).
+    ``net_errors``: why a piece has no net (None where it has one); ``polylines``: the splice
+    lines as drawn (:meth:`outline` follows them).
     """
 
     before: PatternResult
@@ -89,6 +90,7 @@ class SplicedPly:
     seconds: float
     nets: list[PlyDrape | None] | None = None
     net_errors: list[str | None] | None = None
+    polylines: list[np.ndarray] | None = None
 
     @property
     def splice_lines(self) -> list[np.ndarray]:
@@ -113,6 +115,51 @@ class SplicedPly:
     def relieved(self) -> bool:
         """Whether every piece converged with its largest shear below the locking angle."""
         return bool(self.converged and self.max_shear_after < self.locking_angle)
+
+    def outline(self, index: int) -> list[np.ndarray]:
+        """The flat boundary rings ``(k, 2)`` of piece ``index`` (its mesh's boundary loops, in
+        their order, in its pattern's frame), the points along a splice moved onto the splice
+        line as drawn.
+
+        The cut runs through nodes within :data:`SPLICE_SNAP` of a cell from the drawn line (no
+        slivers), so the piece's edge along a splice zigzags round the line by up to 0.4 of an
+        edge. Every boundary node on a splice is replaced by the flat image of its point on the
+        drawn line: the closest point of the line, or at a splice's end on the mould's boundary
+        the line's end, or where two splices cross the point where the drawn lines cross (the
+        closest pair of their points). Each point is located in the piece's nearest cell and
+        mapped with that cell's affine map from the mould to the pattern (beyond the cell, where
+        the line passes outside the piece, the same map extended). The piece's mesh and pattern
+        stay as solved; without :attr:`polylines` the rings are the mesh's loops."""
+        from scipy.spatial import cKDTree
+
+        from ..geometry.surface_points import FaceLocator, barycentric
+
+        piece, result = self.pieces[index].mesh, self.results[index]
+        flat = result.material_coordinates
+        loops = piece.boundary_loops()
+        rings = [flat[loop].copy() for loop in loops]
+        if not self.polylines:
+            return rings
+        points = self.cut.mesh.points
+        size = float(np.ptp(points, axis=0).max())
+        on = cKDTree(np.vstack([points[chain] for chain in self.cut.lines]))
+        ends = cKDTree(np.vstack([points[chain[[0, -1]]] for chain in self.cut.lines]))
+        edge = _mean_edge(piece)
+        curves = [densified(np.asarray(c, dtype=float), 0.05 * edge) for c in self.polylines]
+        tips = np.vstack([c[[0, -1]] for c in curves])
+        locate = FaceLocator(piece)
+        triangles = piece.cells["triangle"]
+        for ring, loop in zip(rings, loops, strict=True):
+            at = piece.points[loop]
+            for k in np.flatnonzero(on.query(at)[0] <= 1e-9 * size):
+                end = bool(ends.query(at[k])[0] <= 1e-9 * size)
+                target = _on_drawn(at[k], curves, tips, edge, end)
+                if target is None:
+                    continue
+                face = int(locate.locate(target)[0][0])
+                weights, _ = barycentric(target, piece.points[triangles[face]])
+                ring[k] = weights @ flat[triangles[face]]
+        return rings
 
     def cell_field(self, name: str) -> np.ndarray:
         """A per-cell field of the pieces' patterns on ``cut.mesh``'s cells ``(m, …)``."""
@@ -198,7 +245,8 @@ def solve_with_splices(
     if not len(polylines):
         raise CuttingError("splices need at least one splice line")
     surface = triangulated(mesh)
-    cut = cut_along(surface, [np.asarray(p, dtype=float) for p in polylines], snap)
+    lines = [np.asarray(p, dtype=float) for p in polylines]
+    cut = cut_along(surface, lines, snap)
     if cut.num_panels < 2:
         raise CuttingError(
             "the splice lines do not cut the mould into pieces: draw each from the boundary "
@@ -211,7 +259,52 @@ def solve_with_splices(
     clock = time.perf_counter()
     results = [solve(piece.mesh, material, thickness, **settings) for piece in pieces]
     seconds = time.perf_counter() - clock
-    return SplicedPly(before, cut, pieces, results, float(locking_angle), seconds)
+    return SplicedPly(
+        before, cut, pieces, results, float(locking_angle), seconds, polylines=list(lines)
+    )
+
+
+def _on_drawn(
+    point: np.ndarray, curves: list[np.ndarray], tips: np.ndarray, edge: float, end: bool
+) -> np.ndarray | None:
+    """The point of the drawn ``curves`` (densified) that the cut's node at ``point`` stands
+    for: its closest point; for a line's ``end`` the drawn line's end (within an ``edge`` of
+    it) or, where two lines cross, the midpoint of their closest pair of points near it; None
+    for an end that is neither."""
+    if not end:
+        return min((_closest_on(point, c) for c in curves), key=lambda q: q[1])[0]
+    distance = np.linalg.norm(tips - point, axis=1)
+    if distance.min() < edge:
+        return tips[int(np.argmin(distance))]
+    from scipy.spatial import cKDTree
+
+    near = [c[np.linalg.norm(c - point, axis=1) < 3.0 * edge] for c in curves]
+    near = [c for c in near if len(c)]
+    best = None
+    for i in range(len(near)):
+        tree = cKDTree(near[i])
+        for j in range(i + 1, len(near)):
+            gap, index = tree.query(near[j])
+            k = int(np.argmin(gap))
+            if best is None or gap[k] < best[0]:
+                best = (gap[k], 0.5 * (near[j][k] + near[i][index[k]]))
+    return None if best is None else best[1]
+
+
+def _mean_edge(mesh: SurfaceMesh) -> float:
+    edges = mesh.edges()
+    return float(np.linalg.norm(np.diff(mesh.points[edges], axis=1), axis=2).mean())
+
+
+def _closest_on(point: np.ndarray, curve: np.ndarray) -> tuple[np.ndarray, float]:
+    """The closest point of the polyline ``curve`` ``(k, 3)`` to ``point`` and its distance."""
+    a, d = curve[:-1], np.diff(curve, axis=0)
+    length = np.einsum("ij,ij->i", d, d)
+    t = np.einsum("ij,ij->i", point - a, d) / np.where(length > 0, length, 1.0)
+    closest = a + np.clip(t, 0.0, 1.0)[:, None] * d
+    distance = np.linalg.norm(closest - point, axis=1)
+    k = int(np.argmin(distance))
+    return closest[k], float(distance[k])
 
 
 def cut_along(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap: float) -> CutMesh:

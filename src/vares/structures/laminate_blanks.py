@@ -12,10 +12,13 @@ comes with its warp along +x, which is the roll's direction: the plies are neste
 A darted ply's blank is its pattern opened along the darts: the darts' lips are part of its net
 boundary, and its ``darts`` are both lips of each, mouth → tip → mouth, in the pattern frame.
 A spliced ply is cut as several blanks, one per piece (in the order of the pieces, named
-``"<ply> piece-1"`` … by :attr:`PlyBlank.label`): each is nested on its own; its rosette sits at
-the pattern point of its node nearest the seed when the seed lies on it, else of its node
-nearest its centroid. :func:`side_by_side` lays a ply's pieces out in one frame (its cutter file,
-its pattern file).
+``"<ply> piece-1"`` … by :attr:`PlyBlank.label`): each is nested on its own; its net boundary
+along a splice follows the splice line as drawn, mapped into its pattern
+(:meth:`vares.analysis.splices.SplicedPly.outline`: the mesh's edge there zigzags round the line
+by up to 0.4 of an edge, through the nodes the cut snapped to); its rosette sits at
+the pattern point of its node nearest the seed when the seed lies inside it, else (also when
+the seed lies on a splice) of its node nearest its centroid. :func:`side_by_side` lays a ply's
+pieces out in one frame (its cutter file, its pattern file).
 A ply's mass is that of its flat blank: the areal weight (g/m², of the undeformed fabric) times
 the pattern's area.
 """
@@ -49,7 +52,8 @@ __all__ = [
 class PlyBlank:
     """One ply's blank in its pattern frame (mesh units, warp along +x).
 
-    ``net``: the pattern's boundary rings ``(k, 2)``, the outline first, then holes; ``trim``:
+    ``net``: the pattern's boundary rings ``(k, 2)``, the outline first, then holes (a spliced
+    piece's along its splices on the drawn lines: module docs); ``trim``:
     the extended boundary's rings, likewise; ``origin`` ``(2,)``: the rosette's point (the
     pattern point of the mould node nearest the seed); ``warp``, ``fill`` ``(2,)``: the unit yarn
     directions of the pattern; ``net_area``, ``trim_area``: flat areas; ``surface_area``: the 3D
@@ -112,7 +116,10 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
             coordinates = pattern.material_coordinates
             key = (drape.label, piece)
             if key not in outlines:  # the plies of one drape share its outlines
-                loops = [coordinates[loop] for loop in mesh.boundary_loops()]
+                if drape.is_spliced:  # along a splice: the line as drawn
+                    loops = drape.spliced.outline(index)
+                else:
+                    loops = [coordinates[loop] for loop in mesh.boundary_loops()]
                 loops.sort(key=lambda r: -abs(ring_area(r)))
                 net = [
                     r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)
@@ -149,14 +156,19 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
     return blanks
 
 
-def _seed_piece(pieces, seed: np.ndarray) -> int:
-    """The index of the piece whose surface lies nearest the seed (the one it lies on)."""
+def _seed_piece(pieces, seed: np.ndarray) -> int | None:
+    """The index of the piece whose surface lies nearest the seed (the one it lies on); None
+    when the seed's nearest node of it is on its boundary (the seed on a splice: at the edge
+    of every piece beside it)."""
     from ..geometry.surface_points import FaceLocator
 
     distance = [
         float(np.linalg.norm(FaceLocator(p.mesh).locate(seed)[2][0] - seed)) for p in pieces
     ]
-    return int(np.argmin(distance))
+    index = int(np.argmin(distance))
+    mesh = pieces[index].mesh
+    node = int(np.argmin(np.linalg.norm(mesh.points - seed, axis=1)))
+    return None if node in set(mesh.boundary_edges().ravel().tolist()) else index
 
 
 def side_by_side(blanks: Sequence[PlyBlank], gap: float = 0.4) -> list[np.ndarray]:
