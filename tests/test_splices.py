@@ -269,7 +269,8 @@ def test_splice_lines_that_do_not_cut_the_mould_are_refused():
 
 def test_drape_command_with_splice_lines(tmp_path):
     """``vares drape --splice-lines``: the pieces' table and verdict, drape.json's splices,
-    splices.vtu (the mould cut into pieces) and pieces.dxf (one seam and cut line per piece);
+    splices.vtu (the mould cut into pieces) and pieces.dxf (one seam and cut line per piece, the
+    seam along the drawn splice);
     splices with darts, or without a fabric, are refused before anything is solved."""
     lines = tmp_path / "splice.txt"
     lines.write_text("\n".join(" ".join(f"{v:.6f}" for v in p) for p in axis_splice("x")) + "\n")
@@ -295,8 +296,18 @@ def test_drape_command_with_splice_lines(tmp_path):
     assert np.nanmax(np.abs(cut.cell_data["shear_angle"][0])) == pytest.approx(
         data["max_shear_after"]
     )
-    layers = [e.dxf.layer for e in ezdxf.readfile(out / "pieces.dxf").modelspace()]
+    space = ezdxf.readfile(out / "pieces.dxf").modelspace()
+    layers = [e.dxf.layer for e in space]
     assert layers.count("SEAM") == 2 and layers.count("CUT") == 2
+    # the seam lines follow the drawn splice, not the zigzag of the cut's nodes: no corner but
+    # the two where the splice meets the outline turns by more than 25° (the mesh's edges: teeth
+    # of up to 143°)
+    for seam in (e for e in space if e.dxf.layer == "SEAM"):
+        ring = np.array([p[:2] for p in seam.get_points()])
+        before, after = ring - np.roll(ring, 1, 0), np.roll(ring, -1, 0) - ring
+        cross = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
+        turns = np.sort(np.abs(np.degrees(np.arctan2(cross, (before * after).sum(1)))))
+        assert turns[-3] < 25.0 < turns[-2]
     refused = run(*common, *fabric, "--darts", "auto", "-o", tmp_path / "both")
     assert refused.exit_code == 2
     assert "give darts or --splice-lines, not both" in error_line(refused)

@@ -47,8 +47,9 @@ class CutPiece:
     label lines, optionally match mark positions (model units, ``(k, 2)``, on the seam line)
     that replace the regularly spaced ones, optionally its cut line (a ring ``(k, 2)`` in
     model units, e.g. with an allowance per edge) that replaces the seam line grown by the
-    drawing's allowance, and its darts (open polylines ``(k, 2)`` in model units, drawn on
-    layer ``DART``)."""
+    drawing's allowance, its darts (open polylines ``(k, 2)`` in model units, drawn on
+    layer ``DART``), and optionally its seam rings (``(k, 2)`` each, model units) that replace
+    the mesh's boundary loops (a spliced piece's edges on the drawn splice line)."""
 
     name: str
     mesh: SurfaceMesh
@@ -58,6 +59,7 @@ class CutPiece:
     marks: np.ndarray | None = field(default=None, repr=False)
     cut: np.ndarray | None = field(default=None, repr=False)
     darts: Sequence[np.ndarray] = field(default=(), repr=False)
+    seams: Sequence[np.ndarray] | None = field(default=None, repr=False)
 
 
 def _marks_along(ring: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
@@ -112,7 +114,10 @@ def write_dxf(
     cursor = 0.0
     for piece in pieces:
         coordinates = np.asarray(piece.coordinates, dtype=float) * factor
-        seams = [coordinates[loop] for loop in piece.mesh.boundary_loops()]
+        if piece.seams is not None:
+            seams = [np.asarray(ring, dtype=float) * factor for ring in piece.seams]
+        else:
+            seams = [coordinates[loop] for loop in piece.mesh.boundary_loops()]
         if piece.cut is not None:
             cuts = [np.asarray(piece.cut, dtype=float) * factor]
         else:

@@ -333,11 +333,14 @@ def _write_splices(folder, paths: list[Path], spliced, units: str, name: str) ->
     }
     write_surface(folder.staged(paths[0]), cut.mesh, None, fields)
     pieces = []
-    for piece, result in zip(spliced.pieces, spliced.results, strict=True):
+    for index, (piece, result) in enumerate(zip(spliced.pieces, spliced.results, strict=True)):
         largest = float(np.nanmax(np.abs(result.fields["shear_angle"])))
         label = [f"{name} {piece.name}", f"largest shear {largest:.1f}°"]
         warp = None if result.fibres is None else result.fibres.warp
-        pieces.append(CutPiece(piece.name, result.mesh, result.material_coordinates, warp, label))
+        seams = spliced.outline(index)  # along a splice, the drawn line
+        pieces.append(
+            CutPiece(piece.name, result.mesh, result.material_coordinates, warp, label, seams=seams)
+        )
     write_dxf(folder.staged(paths[1]), pieces, units=units, model_units=units)
     figure = plot_splices(spliced)
     figure.savefig(folder.staged(paths[2]))
