@@ -209,6 +209,42 @@ def test_each_piece_is_a_blank_and_all_are_nested(spliced, tmp_path):
     assert sum(text == "A piece-3" for text in labels) == 1
 
 
+def test_the_laminates_automatic_darts_pass_a_spliced_ply_by():
+    """``darts = "auto"`` for the laminate darts the ply that names no splices and leaves the
+    spliced one to its pieces: at a locking angle of 6° the 0° and 90° plies (8.2° on this cap)
+    both need darts; the 90° ply C gets them, the spliced 0° ply A none."""
+    result = drape_laminate(
+        mould(),
+        [plies()[0], Ply(PlyOptions(name="C", orientation=90.0), NCF)],
+        workers=1,
+        kinematic=False,
+        darts="auto",
+        locking_angle=6.0,
+    )
+    a, c = result.drape("A"), result.drape("C")
+    assert a.is_spliced and a.darted is None and not a.is_darted
+    assert c.is_darted and not c.is_spliced
+
+
+def test_plies_share_a_drape_only_with_the_same_splices():
+    """The drape's key digests the lines one by one: two lines are not their concatenation,
+    and the same lines give the same key (the plies of a symmetric stack share a drape)."""
+    from vares.structures.laminate_options import LaminateOptions
+    from vares.structures.laminate_tasks import drape_key
+
+    ply, options = plies()[0], LaminateOptions()
+    seed, cells = np.zeros(3), np.arange(4)
+
+    def key(lines):
+        return drape_key(ply, options, seed, cells, None, {"locking_angle": 50.0,
+                                                           "polylines": lines})  # fmt: skip
+
+    first, second = SPLICES
+    assert key([first, second]) == key([first.copy(), second.copy()])
+    assert key([first, second]) != key([np.vstack([first, second])])
+    assert key([first, second]) != key([second, first])
+
+
 def test_a_seed_inside_a_piece_holds_its_rosette():
     seed = mould().points[23]  # (-4, -3): inside the piece on x < 0.37, y < -0.41
     result = drape_laminate(

@@ -79,8 +79,8 @@ class PlyDrapeResult:
     yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
     laid (the darted or spliced patterns', each mould cell the area-weighted mean of its pieces
     in the opened or cut mesh: :func:`~vares.structures.laminate_tasks.on_mould_cells`), and the
-    kinematic
-    ``kinematic_warp``, ``kinematic_fill``, ``kinematic_shear_angle``. The pair check uses
+    kinematic ``kinematic_warp``, ``kinematic_fill``, ``kinematic_shear_angle`` (a spliced
+    ply's from its pieces' own nets, likewise). The pair check uses
     ``pattern``, the ply without darts or splices, on the mould's cells.
     """
 

@@ -213,9 +213,9 @@ def _digested(lines: dict | None) -> tuple | None:
     if lines is None:
         return None
     if lines["polylines"] is not None:
-        digest = hashlib.sha1(
-            b"".join(np.ascontiguousarray(p).tobytes() for p in lines["polylines"])
-        )
+        digest = hashlib.sha1()
+        for p in lines["polylines"]:  # each line's shape too: [A, B] is not [A + B]
+            digest.update(repr(np.shape(p)).encode() + np.ascontiguousarray(p).tobytes())
         lines = {**lines, "polylines": digest.hexdigest()}
     return tuple(sorted(lines.items()))
 
