@@ -286,6 +286,9 @@ def test_the_ply_book_has_a_section_per_piece(spliced):
         assert f"Ply A, piece-{k} of 4" in section
         assert "<h3>Splices</h3>" in section
         assert f"{a.max_shear_before:.4g}°" in section
+        # the whole ply's picture with its splices, once: in the first piece's section
+        assert (f'id="figure-A-piece-{k}-splices"' in section) == (k == 1)
+    assert text.count('-splices"') == 1
     assert "id='ply-B'" in text
 
 
@@ -336,6 +339,7 @@ def test_cli_cuts_a_spliced_ply_into_pieces(tmp_path):
         assert f'id="splices-A-piece-{k}"' in section
         for kind in ("blank", "shear", "producibility"):
             assert f'id="figure-A-piece-{k}-{kind}"' in section
+        assert (f'id="figure-A-piece-{k}-splices"' in section) == (k == 1)
 
 
 def test_splice_options_are_checked(tmp_path):

@@ -8,7 +8,8 @@ rosette (the 0° arrow along the warp, the 90° arrow along the fill, at the see
 producibility maps (a darted ply's dart lines drawn on the blank and on both maps), its numbers,
 and its darts: their lengths on the mould, the mouths' openings in the blank and the largest
 shear before and after, or, without darts, how much of the ply is at or beyond the locking angle.
-A spliced ply has a section per piece, with the splices instead of the darts.
+A spliced ply has a section per piece, with the splices instead of the darts; its first piece's
+section shows the whole ply's shear on the mould beside the pieces' and the flat pieces.
 
 Producibility here is that of the blank as cut (opened along its darts, if any): the mechanical
 drape's shear angle against the ply's locking angle (its own, the laminate's or its fabric
@@ -237,7 +238,7 @@ def _nest_section(nest: RollNest | None, blanks, units: str) -> list[str]:
     ]
 
 
-def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> list[str]:
+def _ply_section(result, blank, check, units, figures: dict[tuple, list[str]]) -> list[str]:
     drape: PlyDrapeResult = result.drape(blank.name)
     ply = next(p for p in result.laminate.plies if p.name == blank.name)
     pattern = drape.pattern
@@ -277,6 +278,8 @@ def _ply_section(result, blank, check, units, figures: dict[str, list[str]]) -> 
         heading += f", {html.escape(blank.piece)} of {blank.pieces}"
     if drape.spliced is not None:
         lines = ["<h3>Splices</h3>", *_splices_part(drape, blank, check, ident, units)]
+        if blank.piece == drape.spliced.pieces[0].name:  # the whole ply's picture, once
+            lines += [part.replace("{ply}", ident) for part in figures[drape.label, "splices"]]
     else:
         lines = ["<h3>Darts</h3>", *_darts_part(drape, check, ident, units)]
     return [
@@ -308,6 +311,19 @@ def _splices_part(
         "piece's area is at or beyond it."
     )
     return [f"<p id='splices-{ident}'>{html.escape(text)}</p>"]
+
+
+def _splices_figure(spliced) -> str:
+    """The spliced ply's shear on the mould, whole and in its pieces (the splice lines in
+    black), and its flat pieces (:func:`vares.io.dart_plots.plot_splices`)."""
+    from ..io.dart_plots import plot_splices
+
+    caption = (
+        f"the ply's shear on the mould, whole (largest {spliced.max_shear_before:.1f}°) and in "
+        f"its {len(spliced.pieces)} pieces ({spliced.max_shear_after:.1f}°; the splice lines in "
+        "black), and the flat pieces"
+    )
+    return figure(plot_splices(spliced, dpi=REPORT_DPI), caption, "figure-{ply}-splices")
 
 
 def _curvature_advice(darted) -> str:
@@ -452,5 +468,8 @@ def ply_book(
             if key not in figures:
                 shear = result.drape(blank.name).piece(blank.piece).pattern.fields["shear_angle"]
                 figures[key] = _drape_figures(blank, shear, check, units)
+            spliced = result.drape(blank.name).spliced
+            if spliced is not None and (blank.drape, "splices") not in figures:
+                figures[blank.drape, "splices"] = [_splices_figure(spliced)]
             parts += _ply_section(result, blank, check, units, figures)
     return "\n".join([*parts, "</body></html>"])
