@@ -325,3 +325,15 @@ def test_drape_command_with_splice_lines(tmp_path):
     assert bare.exit_code == 2
     assert "splices need the ply's fabric" in error_line(bare)
     assert not (tmp_path / "both").exists() and not (tmp_path / "bare").exists()
+
+
+def test_the_nearest_segment_of_a_line_with_a_repeated_point():
+    """A drawn line may repeat a point (a CAD polyline's doubled vertex): its segment of zero
+    length is its point, not a NaN that the search for the nearest would pick."""
+    from vares.analysis.darts import to_segments
+
+    line = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    distance, index, t = to_segments(np.array([1.5, 0.5, 0.0]), line[:-1], line[1:])
+    assert (distance, index, t) == (pytest.approx(0.5), 2, pytest.approx(0.5))
+    distance, index, t = to_segments(np.array([1.0, 2.0, 0.0]), line[1:2], line[2:3])
+    assert np.isfinite(t) and distance == pytest.approx(2.0)

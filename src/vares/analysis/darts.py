@@ -68,6 +68,7 @@ __all__ = [
     "place_darts",
     "smoothed",
     "solve_with_darts",
+    "to_segments",
 ]
 
 
@@ -215,10 +216,10 @@ def darts_from_polylines(mesh: SurfaceMesh, polylines: Sequence[np.ndarray]) -> 
                 f"dart line {index} lies up to {distance.max():.4g} from the mould: draw it on it"
             )
         on_surface = np.einsum("kc,kcd->kd", bary, points[triangles[faces]])
-        gaps = [_to_segments(p, a, b)[0] for p in (on_surface[0], on_surface[-1])]
+        gaps = [to_segments(p, a, b)[0] for p in (on_surface[0], on_surface[-1])]
         if gaps[1] < gaps[0]:
             on_surface, faces = on_surface[::-1], faces[::-1]
-        _, side, t = _to_segments(on_surface[0], a, b)
+        _, side, t = to_segments(on_surface[0], a, b)
         face, corner = (int(v) for v in sides[side])
         start = np.zeros(3)
         start[(corner + 1) % 3], start[(corner + 2) % 3] = 1.0 - t, t
@@ -241,11 +242,12 @@ def darts_from_polylines(mesh: SurfaceMesh, polylines: Sequence[np.ndarray]) -> 
     return lines
 
 
-def _to_segments(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[float, int, float]:
+def to_segments(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[float, int, float]:
     """The distance from ``point`` to the nearest of the segments ``a``–``b`` ``(s, 3)``, its
-    index and the fraction along it."""
+    index and the fraction along it (a segment of zero length: its point)."""
     d = b - a
-    t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
+    length = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.where(length > 0, length, 1.0), 0.0, 1.0)
     distance = np.linalg.norm(a + t[:, None] * d - point, axis=1)
     k = int(np.argmin(distance))
     return float(distance[k]), k, float(t[k])

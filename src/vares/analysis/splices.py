@@ -26,14 +26,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..geometry.cutting import CutMesh, LinesMeetError, cut_mesh
-from ..geometry.drawn_lines import curves_on_surface, densified
+from ..geometry.drawn_lines import curves_on_surface, densified, point_spacing
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.surface_lines import CuttingError, triangulated
 from ..materials import Hyperelastic
 from ..solver.api import solve
 from ..solver.result import PatternResult
 from ..structures.panels import Panel, split_panels
-from .darts import smoothed
+from .darts import smoothed, to_segments
 
 if TYPE_CHECKING:
     from .drape import PlyDrape
@@ -144,7 +144,7 @@ class SplicedPly:
         size = float(np.ptp(points, axis=0).max())
         on = cKDTree(np.vstack([points[chain] for chain in self.cut.lines]))
         ends = cKDTree(np.vstack([points[chain[[0, -1]]] for chain in self.cut.lines]))
-        edge = _mean_edge(piece)
+        edge = 2.0 * point_spacing(piece)  # the mean edge
         curves = [densified(np.asarray(c, dtype=float), 0.05 * edge) for c in self.polylines]
         tips = np.vstack([c[[0, -1]] for c in curves])
         locate = FaceLocator(piece)
@@ -291,20 +291,10 @@ def _on_drawn(
     return None if best is None else best[1]
 
 
-def _mean_edge(mesh: SurfaceMesh) -> float:
-    edges = mesh.edges()
-    return float(np.linalg.norm(np.diff(mesh.points[edges], axis=1), axis=2).mean())
-
-
 def _closest_on(point: np.ndarray, curve: np.ndarray) -> tuple[np.ndarray, float]:
     """The closest point of the polyline ``curve`` ``(k, 3)`` to ``point`` and its distance."""
-    a, d = curve[:-1], np.diff(curve, axis=0)
-    length = np.einsum("ij,ij->i", d, d)
-    t = np.einsum("ij,ij->i", point - a, d) / np.where(length > 0, length, 1.0)
-    closest = a + np.clip(t, 0.0, 1.0)[:, None] * d
-    distance = np.linalg.norm(closest - point, axis=1)
-    k = int(np.argmin(distance))
-    return closest[k], float(distance[k])
+    distance, k, t = to_segments(point, curve[:-1], curve[1:])
+    return curve[k] + t * (curve[k + 1] - curve[k]), distance
 
 
 def cut_along(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap: float) -> CutMesh:
@@ -328,7 +318,7 @@ def _piece_by_piece(surface: SurfaceMesh, polylines: Sequence[np.ndarray], snap:
     The pieces are then welded into one cut mesh, its lines the splices piece by piece."""
     from scipy.spatial import cKDTree
 
-    from ..geometry.drawn_lines import closest_points, point_spacing
+    from ..geometry.drawn_lines import closest_points
     from ..geometry.surface_lines import min_angles
     from ..geometry.weld import weld
 
