@@ -306,17 +306,16 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
     spliced: SplicedPly | None = outcome.get("spliced")
     shear = pattern.fields["shear_angle"]
     if spliced is not None:  # the ply as laid: its pieces, read back
-        warp, fill, shear = _spliced_on_mould(sub, spliced)
+        # each cut cell's mould cell, once for the pieces' patterns and their nets
+        back = (cut_origin(sub, spliced.cut.mesh), spliced.cut.mesh.cell_areas(), sub.num_cells)
+        warp, fill, shear = _read_back(*back, *_spliced_yarns(spliced))
     elif darts_used(darted):  # the ply as laid: opened, read back
         opened, laid = darted.slits.mesh, darted.after
         warp, fill = draped_yarns(
             opened, laid.material_coordinates, laid.fibres.warp, laid.fibres.fill
         )
-        origin, areas = darted.slits.cell_origin, opened.cell_areas()
-        count = sub.num_cells
-        warp = on_mould_cells(warp, origin, areas, count, unit=True)
-        fill = on_mould_cells(fill, origin, areas, count, unit=True)
-        shear = on_mould_cells(laid.fields["shear_angle"], origin, areas, count)
+        back = (darted.slits.cell_origin, opened.cell_areas(), sub.num_cells)
+        warp, fill, shear = _read_back(*back, warp, fill, laid.fields["shear_angle"])
     else:
         warp, fill = draped_yarns(
             sub, pattern.material_coordinates, pattern.fibres.warp, pattern.fibres.fill
@@ -327,7 +326,7 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         net_warp, net_fill = kinematic.drape.warp, kinematic.drape.fill
         net_shear = kinematic.drape.shear_angle
         if spliced is not None and spliced.nets is not None:  # the pieces' nets, as laid
-            net_warp, net_fill, net_shear = _spliced_nets_on_mould(sub, spliced)
+            net_warp, net_fill, net_shear = _read_back(*back, *_spliced_nets(spliced))
     else:
         net_warp, net_fill, net_shear = nan3, nan3, np.full(len(cells), np.nan)
     return PlyDrapeResult(
@@ -357,9 +356,9 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
     )
 
 
-def _spliced_on_mould(sub: SurfaceMesh, spliced: SplicedPly) -> tuple[np.ndarray, ...]:
-    """A spliced ply's draped warp, fill ``(k, 3)`` and shear ``(k,)`` per cell of its mesh
-    ``sub``: each piece's, through the cut mesh's cells (:func:`on_mould_cells`)."""
+def _spliced_yarns(spliced: SplicedPly) -> tuple[np.ndarray, ...]:
+    """A spliced ply's draped warp, fill ``(k, 3)`` and shear ``(k,)`` per cell of its cut
+    mesh: each piece's."""
     cut = spliced.cut
     warp, fill = np.zeros((cut.mesh.num_cells, 3)), np.zeros((cut.mesh.num_cells, 3))
     for index, (piece, result) in enumerate(zip(spliced.pieces, spliced.results, strict=True)):
@@ -367,30 +366,28 @@ def _spliced_on_mould(sub: SurfaceMesh, spliced: SplicedPly) -> tuple[np.ndarray
         warp[cells], fill[cells] = draped_yarns(
             piece.mesh, result.material_coordinates, result.fibres.warp, result.fibres.fill
         )
-    return _on_mould(sub, spliced, warp, fill, spliced.cell_field("shear_angle"))
+    return warp, fill, spliced.cell_field("shear_angle")
 
 
-def _spliced_nets_on_mould(sub: SurfaceMesh, spliced: SplicedPly) -> tuple[np.ndarray, ...]:
-    """The warp, fill and shear of a spliced ply's kinematic nets (one per piece) per cell of its
-    mesh ``sub``, as :func:`_spliced_on_mould`; NaN over a piece without a net."""
+def _spliced_nets(spliced: SplicedPly) -> tuple[np.ndarray, ...]:
+    """The warp, fill and shear of a spliced ply's kinematic nets (one per piece) per cell of
+    its cut mesh; NaN over a piece without a net."""
     cut = spliced.cut
     count = cut.mesh.num_cells
-    warp, fill, shear = (
-        np.full((count, 3), np.nan),
-        np.full((count, 3), np.nan),
-        np.full(count, np.nan),
-    )
+    warp, fill = np.full((count, 3), np.nan), np.full((count, 3), np.nan)
+    shear = np.full(count, np.nan)
     for index, net in enumerate(spliced.nets or []):
         if net is not None:
             cells = cut.panel_ids == index
             warp[cells], fill[cells] = net.drape.warp, net.drape.fill
             shear[cells] = net.drape.shear_angle
-    return _on_mould(sub, spliced, warp, fill, shear)
+    return warp, fill, shear
 
 
-def _on_mould(sub, spliced, warp, fill, shear) -> tuple[np.ndarray, ...]:
-    origin, areas = cut_origin(sub, spliced.cut.mesh), spliced.cut.mesh.cell_areas()
-    count = sub.num_cells
+def _read_back(origin, areas, count, warp, fill, shear) -> tuple[np.ndarray, ...]:
+    """Warp, fill and shear of an opened or cut mesh's cells (each in the ply's cell
+    ``origin``, of 3D ``areas``) per cell of the ply's mesh (``count`` cells;
+    :func:`on_mould_cells`)."""
     return (
         on_mould_cells(warp, origin, areas, count, unit=True),
         on_mould_cells(fill, origin, areas, count, unit=True),
