@@ -6,11 +6,15 @@ The file is not shipped (Kratos is BSD-4 licensed): take it from the Kratos repo
 its walls, and a flange out to ±75 mm at z = 0, in mm (689 nodes, 1,226 membrane triangles).
 Printed: the kinematic drape from the punch face's centre (warp along x, spacing 2 mm); the
 README's non-crimp fabric's pattern and the share of its area beyond the locking angle that is
-negatively curved; the automatic darts; and four given darts along the diagonals, from the
-flange's corners towards the centre to ``|x| = |y| = t`` for every ``--tips t`` (the sections
-of the surface by the diagonal planes), each set opened on the pattern.
+negatively curved; the automatic darts (every solve with darts: the rule that placed them, its
+largest shear; the darts kept); and four given darts along the diagonals, from the flange's
+corners towards the centre to ``|x| = |y| = t`` for every ``--tips t`` (the sections of the
+surface by the diagonal planes), each set opened on the pattern. ``--square-cup CELLS:SEED``
+drapes ``vares.geometry.hard_surfaces.square_cup(CELLS, seed=SEED)`` instead (a box of the same
+size, made here, irregular triangles), one after the other, for every value given.
 
     python benchmarks/cup_darts.py cup.mdpa --tips 40 34 28 22 15 8
+    python benchmarks/cup_darts.py --square-cup 40:1 50:1 60:1 60:2 60:3 80:1 --tips 28
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ import numpy as np
 
 from vares.analysis.darts import over_locking_curvature, solve_with_darts
 from vares.analysis.drape import drape_ply
+from vares.geometry.hard_surfaces import square_cup
 from vares.geometry.surface_lines import plane_sections
 from vares.io.meshes import read_mesh
 from vares.materials import NonCrimpFabric
@@ -45,14 +50,27 @@ def diagonal(mesh, sx: float, sy: float, tip: float) -> np.ndarray:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("mould", type=Path, help="the cup's .mdpa (or any format vares reads)")
-    parser.add_argument("--tips", type=float, nargs="+", default=[40.0, 34.0, 28.0, 22.0])
-    args = parser.parse_args()
-    mesh = read_mesh(args.mould)
-    print(
-        f"{args.mould.name}: {mesh.num_points} nodes, {mesh.num_cells} cells, "
-        f"area {mesh.area:.1f} mm²"
+    parser.add_argument(
+        "mould", type=Path, nargs="?", help="the cup's .mdpa (or any format vares reads)"
     )
+    parser.add_argument("--tips", type=float, nargs="+", default=[40.0, 34.0, 28.0, 22.0])
+    parser.add_argument("--square-cup", nargs="+", metavar="CELLS:SEED", help="made boxes")
+    args = parser.parse_args()
+    if args.mould is None and not args.square_cup:
+        parser.error("give the cup's file or --square-cup")
+    moulds = [] if args.mould is None else [(args.mould.name, lambda: read_mesh(args.mould))]
+    for value in args.square_cup or []:
+        cells, seed = (int(v) for v in value.split(":"))
+        moulds.append(
+            (f"square_cup({cells}, seed={seed})", lambda c=cells, s=seed: square_cup(c, seed=s))
+        )
+    for name, make in moulds:
+        drape_mould(name, make(), args.tips)
+
+
+def drape_mould(name: str, mesh, tips: list[float]) -> None:
+    """Everything printed for one mould (module docs)."""
+    print(f"{name}: {mesh.num_points} nodes, {mesh.num_cells} cells, area {mesh.area:.1f} mm²")
     clock = time.perf_counter()
     net = drape_ply(mesh, seed=(0.0, 0.0, 25.0), warp=WARP, spacing=2.0, locking_angle=LOCKING)
     check = net.producibility
@@ -72,12 +90,22 @@ def main() -> None:
         f"{100 * shares['negative']:.0f} % negatively, {100 * shares['positive']:.0f} % "
         f"positively curved"
     )
+    for r in summary["rounds"]:
+        print(
+            f"  darts by the {r['rule']}, tip {r['tip_angle']:.1f}°: "
+            f"{len(r['lengths'])} of {min(r['lengths']):.1f}–{max(r['lengths']):.1f} mm, "
+            f"largest shear {r['max_shear']:.2f}° ({r['iterations']} it, converged "
+            f"{r['converged']})"
+        )
+    after = summary["max_shear_after"]
+    mouths = ", ".join(f"{v:.1f}" for v in summary["mouth_openings"])
     print(
-        f"automatic darts: {summary['darts']} placed, largest shear after "
-        f"{summary['max_shear_after']}, kept {summary['kept']}; "
+        f"automatic darts: {summary['darts']} kept {summary['kept']}, by the "
+        f"{summary['chosen_rule']}, largest shear after "
+        f"{'-' if after is None else f'{after:.2f}°'}; mouths {mouths}; "
         f"{time.perf_counter() - clock:.1f} s"
     )
-    for tip in args.tips:
+    for tip in tips:
         lines = [diagonal(mesh, sx, sy, tip) for sx in (1.0, -1.0) for sy in (1.0, -1.0)]
         clock = time.perf_counter()
         darted = solve_with_darts(

@@ -381,3 +381,72 @@ def test_a_pattern_that_did_not_converge_gets_no_darts_and_says_so():
     assert done.before.converged
     assert darts_verdict(done).endswith("NOT below the locking angle (0 solves with darts)")
     assert "no dart placed" in darts_verdict(done)  # beyond the locking angle, none asked for
+
+
+@pytest.fixture(scope="module")
+def square_cup_pattern():
+    """The non-crimp fabric's pattern of a box-shaped mould (warp along x): its corners shear
+    beyond the locking angle at their concave foot, inside the ply."""
+    from vares.geometry.hard_surfaces import square_cup
+    from vares.materials import NonCrimpFabric
+    from vares.solver.api import solve
+
+    mesh = square_cup(60, seed=1)
+    law = NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5])
+    return mesh, law, solve(mesh, law, warp_direction=(1.0, 0.0, 0.0))
+
+
+def test_the_corners_of_a_cup_get_darts_along_their_fall_lines(square_cup_pattern):
+    """Where the bisector leads nowhere (the cells between a corner's region and the flange's
+    edge shear less than the tip angle), a dart runs from the flange's edge up the fall line
+    through the corner's positively curved patch onto the punch face: one per corner, and with
+    them open the shear is below the locking angle."""
+    from vares.analysis.darts import fall_line_darts
+
+    mesh, law, before = square_cup_pattern
+    shear = before.fields["shear_angle"]
+    assert before.converged and np.nanmax(np.abs(shear)) >= LOCKING
+    fibres = before.fibres
+    warp, fill = erected_yarns(mesh, before.material_coordinates, fibres.warp, fibres.fill)
+    assert place_darts(mesh, shear, warp, fill, LOCKING, 0.8 * LOCKING) == []
+    lines = fall_line_darts(mesh, shear, LOCKING, 0.8 * LOCKING)
+    assert len(lines) == 4
+    corners = set()
+    for line in lines:
+        mouth, tip = line.points[0], line.points[-1]
+        assert abs(mouth[2]) < 1e-9 and np.isclose(np.abs(mouth[:2]).max(), 75.0)  # the edge
+        assert tip[2] > 0.95 * 25.0  # on the punch face
+        assert np.all(np.sign(mouth[:2]) == np.sign(tip[:2]))  # in one quadrant
+        corners.add(tuple(np.sign(tip[:2])))
+        assert np.all(np.diff(line.points[:, 2]) > -1e-9)  # up the slope all the way
+    assert len(corners) == 4
+    darted = solve_with_darts(
+        mesh, law, locking_angle=LOCKING, darts="auto", warp_direction=(1.0, 0.0, 0.0)
+    )
+    summary = darted.summary()
+    assert summary["chosen_rule"] == "fall line" and summary["darts"] == 4
+    assert darted.after.converged and darted.kept and darted.relieved
+    assert darted.max_shear_after < 0.7 * LOCKING  # 29.9° against 55.5° without darts
+    assert [r.rule for r in darted.rounds] == ["fall line"]  # the bisector placed none
+
+
+def test_fall_line_darts_move_with_the_mould(square_cup_pattern):
+    """The draw direction is the mould's own (its cells' mean normal): a rigid motion of the
+    mould moves the fall lines' darts with it."""
+    from conftest import rotation
+
+    from vares.analysis.darts import fall_line_darts
+
+    mesh, _, before = square_cup_pattern
+    shear = before.fields["shear_angle"]
+    turn, shift = rotation(5), np.array([300.0, -20.0, 45.0])
+    moved = SurfaceMesh(mesh.points @ turn.T + shift, mesh.cells)
+    found = [fall_line_darts(m, shear, LOCKING, 0.8 * LOCKING) for m in (mesh, moved)]
+    assert len(found[0]) == len(found[1]) == 4
+    for line, other in zip(found[0], found[1], strict=True):
+        assert np.isclose(line.length, other.length, rtol=1e-9)
+        assert np.allclose(line.points @ turn.T + shift, other.points, atol=1e-8)
+    closed = SurfaceMesh(  # a closed surface has no draw direction: no fall line
+        mesh.points * [1, 1, 0], mesh.cells
+    )
+    assert fall_line_darts(closed, shear, LOCKING, 0.8 * LOCKING) == []

@@ -59,7 +59,8 @@ class DartOptions(Options):
     dart_rounds: int = option(
         4,
         "int",
-        "At most this many solves with darts, each with longer darts.",
+        "At most this many solves with darts by each rule (the yarns' bisector, then fall lines),"
+        " each with longer darts.",
         section="drape",
         positive=True,
     )

@@ -8,6 +8,16 @@ reaches the boundary gets one dart from the boundary side nearest the region's s
 centre there (weights: the shear beyond the locking angle); a region inside the surface, from
 the boundary side nearest its most sheared cell.
 
+**Where the bisector leads nowhere** (a region inside the ply, whose cells between it and the
+boundary are sheared less than the tip angle; the corners of a box-shaped part), a dart runs
+along a **fall line** instead (:func:`fall_line_darts`): from the boundary up the slope of the
+mould to the positively curved patch beside the region (the excess fabric a dart takes out lies
+there; the region itself is often negatively curved, at the foot of a corner), and through it.
+The slope is that of the mould's draw direction, the mean of its cells' normals (the direction
+a punch closes in); the line goes straight on where the mould is flat (a flange) and where it
+would turn by more than :data:`FALL_TURN` from one cell to the next. Its tip is where the
+smoothed shear is below the tip angle beyond the positively curved patch.
+
 **Which way.** Sheared yarns at an angle ``θ < 90°`` lengthen the bisector of their acute angle
 (``2 cos(θ/2)``) and shorten the other diagonal (``2 sin(θ/2)``): the fabric is squeezed across
 the bisector. A cut along the bisector opens against that squeeze, and relieves the most shear.
@@ -21,8 +31,11 @@ bisector on the 45° meridians is the meridian itself.
 free boundary, joined at the tip) and solves again, started from the first pattern; while the
 largest shear is still at or beyond the locking angle it lengthens the darts (the tip angle
 lowered by ``dart_step × locking angle``) for at most ``dart_rounds`` rounds
-(:class:`~vares.analysis.dart_options.DartOptions`). Dart lines a user gives
-(polylines near the mould, :func:`darts_from_polylines`) are opened as they are, once.
+(:class:`~vares.analysis.dart_options.DartOptions`). Where the bisector's darts leave it there,
+the fall lines' darts are solved in rounds as well; the round kept is the first below the
+locking angle, else the converged one with the least largest shear, of either rule. Dart lines
+a user gives (polylines near the mould, :func:`darts_from_polylines`) are opened as they are,
+once.
 """
 
 from __future__ import annotations
@@ -36,7 +49,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ..geometry.curvature import curvature_sign_shares
+from ..geometry.curvature import FLAT, cell_gauss_curvature, curvature_sign_shares
 from ..geometry.drawn_lines import closest_points
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.slits import SlitMesh, open_slits, walk_line
@@ -56,14 +69,30 @@ PROGRESS_WINDOW = 64
 #: Darts that leave the shear at or beyond the locking angle where more than this share of the
 #: area beyond it is negatively curved are answered with the advice to splice the ply.
 NEGATIVE_SHARE = 0.5
+#: A fall line goes straight on across a cell whose slope (the sine of its angle to the plane
+#: normal to the draw direction) is below this, and where its slope would turn it by more than
+#: FALL_TURN degrees from its last step (a valley between two cells of a coarse mesh turns the
+#: fall direction back and forth across their common edge).
+FLAT_SLOPE = 0.05
+FALL_TURN = 45.0
+#: The positively curved patch beside a region is looked for within the region's extent from its
+#: most sheared cell, and at least this many mean edge lengths from it.
+PATCH_EDGES = 6.0
+#: A fall line that ends further than this many mean edge lengths from the boundary (it turned
+#: back on itself, or ran into a pit) makes no dart.
+MOUTH_EDGES = 3.0
+#: The rules of automatic darts, in the order they are tried (module docs).
+RULES = ("bisector", "fall line")
 
 __all__ = [
     "NEGATIVE_SHARE",
+    "RULES",
     "DartOptions",
     "DartRound",
     "DartedPattern",
     "darts_from_polylines",
     "erected_yarns",
+    "fall_line_darts",
     "over_locking_curvature",
     "place_darts",
     "smoothed",
@@ -118,28 +147,18 @@ def place_darts(
     one is left out (that one relieves its region)."""
     triangles = mesh.cells["triangle"]
     points = mesh.points
-    magnitude = np.abs(np.nan_to_num(np.asarray(shear_angle, dtype=float), nan=0.0))
-    over = magnitude >= locking_angle
-    if not over.any():
+    found = _Regions(mesh, shear_angle, locking_angle, max_length)
+    if not found.order:
         return []
-    smooth = smoothed(mesh, magnitude)
-    neighbours = face_neighbours(triangles)
+    magnitude, smooth = found.magnitude, found.smooth
     acute = np.einsum("ij,ij->i", warp, fill) >= 0
     bisector = warp + np.where(acute[:, None], fill, -fill)
     bisector /= np.linalg.norm(bisector, axis=1)[:, None]
-    edge = float(np.linalg.norm(np.diff(points[mesh.edges()], axis=1), axis=2).mean())
-    if max_length is None:
-        max_length = 0.5 * float(np.linalg.norm(np.ptp(points, axis=0)))
-    regions = _regions(over | (smooth >= JOIN_FRACTION * locking_angle), neighbours)
-    sides = np.argwhere(neighbours < 0)  # (face, corner opposite the boundary side)
-    mids = 0.5 * (
-        points[triangles[sides[:, 0], (sides[:, 1] + 1) % 3]]
-        + points[triangles[sides[:, 0], (sides[:, 1] + 2) % 3]]
-    )
-    order = sorted(set(regions[over].tolist()), key=lambda r: -magnitude[regions == r].max())
+    sides = found.sides  # (face, corner opposite the boundary side)
+    mids = 0.5 * (found.side_ends[0] + found.side_ends[1])
     lines: list[SurfaceLine] = []
-    for region in order:
-        cells = np.flatnonzero(regions == region)
+    for region in found.order:
+        cells = np.flatnonzero(found.regions == region)
         at_boundary = np.isin(sides[:, 0], cells)
         if at_boundary.any():
             weights = np.maximum(magnitude[sides[at_boundary, 0]] - locking_angle, 0.0) + 1e-9
@@ -158,10 +177,150 @@ def place_darts(
             d = bisector[cell]
             return d if d @ (inward if last is None else last) >= 0 else -d
 
-        line = walk_line(mesh, face, start, direction, max_length)
-        near = [_distance(line.points, other.points) < 2.0 * edge for other in lines]
+        found.keep(walk_line(mesh, face, start, direction, found.max_length), lines)
+    return lines
+
+
+class _Regions:
+    """The regions of a ply's cells at or beyond the locking angle (:func:`place_darts`), largest
+    shear first (``order``), with what both rules of placing darts share: the shear's magnitude
+    and its :func:`smoothed` field, the cells' neighbours, the boundary sides (``sides``: face,
+    corner opposite; ``side_ends``: their end points), the mean edge length and the longest
+    dart."""
+
+    def __init__(
+        self,
+        mesh: SurfaceMesh,
+        shear_angle: np.ndarray,
+        locking_angle: float,
+        max_length: float | None,
+    ) -> None:
+        triangles, points = mesh.cells["triangle"], mesh.points
+        self.magnitude = np.abs(np.nan_to_num(np.asarray(shear_angle, dtype=float), nan=0.0))
+        over = self.magnitude >= locking_angle
+        self.order: list[int] = []
+        if not over.any():
+            return
+        self.smooth = smoothed(mesh, self.magnitude)
+        self.neighbours = face_neighbours(triangles)
+        self.edge = float(np.linalg.norm(np.diff(points[mesh.edges()], axis=1), axis=2).mean())
+        size = float(np.linalg.norm(np.ptp(points, axis=0)))
+        self.max_length = 0.5 * size if max_length is None else max_length
+        joined = over | (self.smooth >= JOIN_FRACTION * locking_angle)
+        self.regions = _regions(joined, self.neighbours)
+        self.sides = np.argwhere(self.neighbours < 0)
+        self.side_ends = tuple(
+            points[triangles[self.sides[:, 0], (self.sides[:, 1] + k) % 3]] for k in (1, 2)
+        )
+        magnitude, regions = self.magnitude, self.regions
+        largest = {r: magnitude[regions == r].max() for r in set(regions[over].tolist())}
+        self.order = sorted(largest, key=lambda r: -largest[r])
+
+    def keep(self, line: SurfaceLine, lines: list[SurfaceLine]) -> None:
+        """Add ``line`` to ``lines`` unless it is shorter than two crossings or comes within two
+        mean edge lengths of one of them (that one relieves its region)."""
+        near = [_distance(line.points, other.points) < 2.0 * self.edge for other in lines]
         if len(line.points) >= 3 and not any(near):
             lines.append(line)
+
+
+def fall_line_darts(
+    mesh: SurfaceMesh,
+    shear_angle: np.ndarray,
+    locking_angle: float,
+    tip_angle: float,
+    max_length: float | None = None,
+) -> list[SurfaceLine]:
+    """Dart lines along fall lines of the mould (module docs) on the triangle mesh ``mesh`` for
+    the per-cell ``shear_angle`` ``(m,)`` (degrees): one per region at or beyond
+    ``locking_angle`` (the regions of :func:`place_darts`) that has a positively curved patch
+    within its extent (at least :data:`PATCH_EDGES` mean edges) from its most sheared cell. The
+    line runs from the boundary up the fall line through the patch's cell nearest its centre
+    (its cells weighted by their curvature times area) and on until the :func:`smoothed` shear
+    is below ``tip_angle`` beyond the patch (a fall line not reaching the boundary makes no
+    dart). None where the mould has no draw direction (its cells' normals cancel: a closed
+    surface)."""
+    triangles = mesh.cells["triangle"]
+    points = mesh.points
+    found = _Regions(mesh, shear_angle, locking_angle, max_length)
+    if not found.order:
+        return []
+    corners = points[triangles]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    up = cross.sum(axis=0)
+    if not np.linalg.norm(up) > 0.2 * area.sum():  # (the sum of the cells' 2 × area normals)
+        return []
+    up /= np.linalg.norm(up)
+    nodal = np.zeros((mesh.num_points, 3))
+    for k in range(3):
+        np.add.at(nodal, triangles[:, k], cross)
+    nodal /= np.maximum(np.linalg.norm(nodal, axis=1), 1e-300)[:, None]
+    normals = nodal[triangles].mean(axis=1)  # a smooth normal field, not the facets'
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    slope = up - (normals @ up)[:, None] * normals  # uphill, of length the slope's sine
+    steep = np.linalg.norm(slope, axis=1) > FLAT_SLOPE
+    curvature = np.nan_to_num(cell_gauss_curvature(mesh), nan=0.0)
+    positive = (curvature * area > FLAT) & steep
+    centres = corners.mean(axis=1)
+    smooth, turn = found.smooth, np.cos(np.radians(FALL_TURN))
+
+    def fall(sense: float, tip: bool):
+        def direction(cell: int, _: np.ndarray, last: np.ndarray | None):
+            if tip and last is not None and smooth[cell] < tip_angle and not positive[cell]:
+                return None
+            step = sense * slope[cell]
+            if last is None:
+                return step if steep[cell] else None
+            straight = step @ last < turn * np.linalg.norm(step) * np.linalg.norm(last)
+            return last if not steep[cell] or straight else step
+
+        return direction
+
+    third = np.full(3, 1.0 / 3.0)
+    polylines = []
+    for region in found.order:
+        cells = np.flatnonzero(found.regions == region)
+        peak = centres[cells[np.argmax(found.magnitude[cells])]]
+        extent = max(
+            float(np.linalg.norm(centres[cells] - peak, axis=1).max()), PATCH_EDGES * found.edge
+        )
+        near = np.flatnonzero(np.linalg.norm(centres - peak, axis=1) <= extent)
+        weight = np.where(positive[near], curvature[near] * area[near], 0.0)
+        if not weight.sum() > 0:
+            continue
+        centre = weight @ centres[near] / weight.sum()
+        patch = near[weight > 0]
+        seed = int(patch[np.argmin(np.linalg.norm(centres[patch] - centre, axis=1))])
+        down = walk_line(mesh, seed, third, fall(-1.0, False), 2.0 * found.max_length)
+        if not len(down.points):
+            continue
+        distance, side, t = to_segments(down.points[-1], *found.side_ends)
+        if distance > MOUTH_EDGES * found.edge:
+            continue  # the fall line does not reach the boundary
+        a, b = found.side_ends[0][side], found.side_ends[1][side]
+        tip = walk_line(mesh, seed, third, fall(1.0, True), found.max_length)
+        # through the middles of the walks' steps, inside their cells (a point on an edge is in
+        # either cell by round-off, and the dart's walk through it could stop or turn there)
+        path = np.vstack([down.points[::-1], centres[seed], tip.points])
+        middles = 0.5 * (path[1:] + path[:-1])
+        polylines.append(
+            np.vstack(
+                [
+                    a + t * (b - a),
+                    middles[: len(down.points)],
+                    centres[seed],
+                    middles[len(down.points) :],
+                ]
+            )
+        )
+    lines: list[SurfaceLine] = []
+    for polyline in polylines:
+        try:
+            (line,) = darts_from_polylines(mesh, [polyline])
+        except CuttingError:  # (a line a dart cannot follow is no dart)
+            continue
+        found.keep(line, lines)
     return lines
 
 
@@ -256,7 +415,9 @@ def to_segments(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[float,
 @dataclass(frozen=True)
 class DartRound:
     """One solve with darts: the tip angle (degrees; None for given lines), the darts' lengths
-    (mesh units), the largest shear after (degrees), Newton iterations, seconds, converged."""
+    (mesh units), the largest shear after (degrees), Newton iterations, seconds, converged, and
+    the rule that placed the darts (:data:`RULES`: ``"bisector"``, ``"fall line"``, or
+    ``"given"``)."""
 
     tip_angle: float | None
     lengths: list[float]
@@ -264,6 +425,7 @@ class DartRound:
     iterations: int
     seconds: float
     converged: bool
+    rule: str = "bisector"
 
 
 @dataclass(frozen=True)
@@ -342,6 +504,7 @@ class DartedPattern:
             "seconds_before": self.before.elapsed,
             "rounds": [vars(r) for r in self.rounds],
             "chosen_round": None if self.after is None else self.chosen % len(self.rounds),
+            "chosen_rule": None if self.after is None else self.rounds[self.chosen].rule,
             "over_locking_curvature": self.over_locking_curvature(),
         }
 
@@ -402,35 +565,42 @@ def solve_with_darts(
     fibres = before.fibres
     warp, fill = erected_yarns(mesh, before.material_coordinates, fibres.warp, fibres.fill)
     shear = before.fields["shear_angle"]
-    plans: list[tuple[float | None, list[SurfaceLine] | None]]
+    plans: list[tuple[float | None, str, list[SurfaceLine] | None]]
     if given is not None:
-        plans = [(None, given)]
+        plans = [(None, "given", given)]
     else:
         if not np.nanmax(np.abs(shear)) >= locking_angle:
             return result
         fractions = [options.dart_tip - r * options.dart_step for r in range(options.dart_rounds)]
-        plans = [(max(f, 0.0) * locking_angle, None) for f in fractions]
+        tips = [max(f, 0.0) * locking_angle for f in fractions]
+        plans = [(tip, rule, None) for rule in RULES for tip in tips]
     locator = FaceLocator(mesh)
     done: list[DartRound] = []
     best: tuple[float, PatternResult, SlitMesh, int] | None = None
-    for tip, lines in plans:
-        if lines is None:
+    finished: set[str] = set()  # rules whose darts grow no longer
+    for tip, rule, lines in plans:
+        if rule in finished:
+            continue
+        if lines is None and rule == "bisector":
             lines = place_darts(
                 mesh, shear, warp, fill, locking_angle, tip, options.dart_max_length
             )
-        if not lines:
-            break
+        elif lines is None:
+            lines = fall_line_darts(mesh, shear, locking_angle, tip, options.dart_max_length)
         lengths = [line.length for line in lines]
-        previous = done[-1].lengths if done else []
-        if len(previous) == len(lengths) and np.allclose(lengths, previous):
-            break  # no longer than the last round's: nothing new to solve
+        previous = next((r.lengths for r in reversed(done) if r.rule == rule), [])
+        if not lines or (len(previous) == len(lengths) and np.allclose(lengths, previous)):
+            finished.add(rule)  # none, or no longer than the last round's: nothing new to solve
+            continue
         slits = open_slits(mesh, lines)
         start = _carried(locator, mesh, before.material_coordinates, slits.mesh.points)
         clock = time.perf_counter()
         after = solve(slits.mesh, material, thickness, **{**solve_settings, "initial_guess": start})
         seconds = time.perf_counter() - clock
         largest = float(np.nanmax(np.abs(after.fields["shear_angle"])))
-        done.append(DartRound(tip, lengths, largest, after.iterations, seconds, after.converged))
+        done.append(
+            DartRound(tip, lengths, largest, after.iterations, seconds, after.converged, rule)
+        )
         rank = largest if after.converged else np.inf
         if best is None or rank < best[0]:
             best = (rank, after, slits, len(done) - 1)

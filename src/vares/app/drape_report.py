@@ -139,6 +139,7 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
     rounds = [
         (
             str(k),
+            r["rule"],
             "given" if r["tip_angle"] is None else f"{number(r['tip_angle'], 4)}°",
             f"{number(r['max_shear'], 4)}°",
             r["iterations"],
@@ -148,7 +149,15 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
         for k, r in enumerate(summary["rounds"], start=1)
     ]
     if rounds:
-        header = ("solve", "dart tip", "largest shear", "iterations", "time", "converged")
+        header = (
+            "solve",
+            "darts by",
+            "dart tip",
+            "largest shear",
+            "iterations",
+            "time",
+            "converged",
+        )
         parts.append(table(rounds, header=header, ident="dart-rounds"))
     from ..io.dart_plots import plot_darts  # when a report is written
 

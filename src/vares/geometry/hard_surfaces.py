@@ -30,6 +30,7 @@ __all__ = [
     "ruffled_fan",
     "scan_like",
     "spherical_cap",
+    "square_cup",
 ]
 
 
@@ -120,6 +121,42 @@ def cap_over_square(
     z = np.sqrt(radius**2 - x**2 - y**2)
     points = np.column_stack([x.ravel(), y.ravel(), z.ravel() - z.min()])
     return SurfaceMesh(points, grid_cells(n + 1, n + 1, cell_type))
+
+
+def square_cup(
+    cells: int = 60,
+    half_width: float = 75.0,
+    top: float = 31.0,
+    foot: float = 45.0,
+    depth: float = 25.0,
+    roundness: float = 6.0,
+    jitter: float = 0.3,
+    seed: int = 1,
+) -> SurfaceMesh:
+    """A box-shaped mould (mm): a punch face of ``depth`` over the rounded square ``ρ ≤ top``,
+    ``ρ = (|x|^p + |y|^p)^(1/p)`` with ``p = roundness`` (round corners), walls falling as a half
+    cosine to the flange at ``ρ = foot``, the flange out to the square of ``half_width``. Nodes of
+    a grid of ``cells`` × ``cells`` moved at random within the square by up to ``jitter`` cells
+    (reproducible by ``seed``; those on the edge stay), triangulated by Delaunay in the plane.
+    Draped with the yarns along x and y, its corners shear most at their concave foot, inside
+    the ply (:func:`vares.analysis.darts.fall_line_darts`)."""
+    from scipy.spatial import Delaunay
+
+    if not 0 < top < foot < half_width:
+        raise ValueError(f"need 0 < top < foot < half_width; got {top}, {foot}, {half_width}")
+    if not 0 <= jitter < 0.5:
+        raise ValueError(f"jitter must lie in [0, 0.5) cells; got {jitter}")
+    s = np.linspace(-half_width, half_width, cells + 1)
+    x, y = (v.ravel() for v in np.meshgrid(s, s, indexing="ij"))
+    inside = (np.abs(x) < half_width) & (np.abs(y) < half_width)
+    shift = np.random.default_rng(seed).uniform(-jitter, jitter, (2, len(x))) * (s[1] - s[0])
+    x, y = x + inside * shift[0], y + inside * shift[1]
+    rho = (np.abs(x) ** roundness + np.abs(y) ** roundness) ** (1.0 / roundness)
+    fall = np.clip((rho - top) / (foot - top), 0.0, 1.0)
+    points = np.column_stack([x, y, 0.5 * depth * (1.0 + np.cos(np.pi * fall))])
+    plane = points[:, :2]
+    triangles = Delaunay(plane).simplices
+    return SurfaceMesh(points, {"triangle": _counter_clockwise(plane, triangles)})
 
 
 def _revolution(
