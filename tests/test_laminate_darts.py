@@ -340,3 +340,56 @@ def test_plies_on_a_dask_cluster_are_those_draped_here(darted, cluster_options):
         np.testing.assert_array_equal(there.shear_angle, here.shear_angle)
     for value in ("warp_compressed_fraction", "mean_deviation"):
         np.testing.assert_array_equal(remote.pair_matrix(value), darted.pair_matrix(value))
+
+
+def test_dart_lips_butt_by_default_and_the_left_lip_laps_by_the_overlap(darted):
+    """A darted blank's trim line keeps the trim allowance along the mould's edge and follows
+    the darts' lips (butt); with ``dart_overlap`` the left lip's edge moves out by it (it laps
+    over the right lip when the dart closes). Cut with the trim allowance on the lips, the lips
+    would overlap by twice the allowance."""
+    from shapely.geometry import LinearRing, Point, Polygon
+
+    from vares.structures.laminate_blanks import ply_blanks
+
+    drape = darted.drape("A")
+    lips = drape.darted.slits.lips
+    coordinates = drape.blank_pattern.material_coordinates
+    for overlap in (0.0, 0.02):  # (the notches are 0.06–0.27 wide along the inner edges)
+        options = darted.laminate.options.replace(dart_overlap=overlap)
+        laminate = type(darted.laminate)(darted.laminate.plies, options)
+        result = type(darted)(**{**darted.__dict__, "laminate": laminate})
+        blank = ply_blanks(result)[0]
+        assert blank.name == "A" and blank.darts
+        trim = LinearRing(blank.trim[0])
+        for left, right in lips:
+            for chain, expected in ((left, overlap), (right, 0.0)):
+                points = coordinates[chain]
+                middles = 0.5 * (points[1:] + points[:-1])
+                # the lip's inner edges (its mouth's and tip's corners mitre further)
+                inner = middles[1:-1]
+                assert len(inner) >= 1
+                distance = [trim.distance(Point(m)) for m in inner]
+                assert np.allclose(distance, expected, atol=1e-9)
+        ring = blank.net[0]
+        on_lip = np.zeros(len(ring), dtype=bool)  # edges with an end on a lip
+        for left, right in lips:
+            for chain in (left, right):
+                near = np.linalg.norm(ring[:, None] - coordinates[chain][None], axis=2)
+                on_lip |= near.min(axis=1) < 1e-12
+        edge = ~on_lip & ~np.roll(on_lip, -1)
+        middles = 0.5 * (ring + np.roll(ring, -1, axis=0))[edge]
+        distance = np.array([trim.distance(Point(m)) for m in middles])
+        assert np.median(distance) == pytest.approx(0.5, abs=1e-9)  # the mould's edge
+        assert Polygon(blank.trim[0]).contains(Polygon(blank.net[0]).buffer(-1e-9))
+
+
+def test_joint_overlaps_are_read_from_a_job_file_and_checked():
+    ply = '\n[[ply]]\nname = "A"\nsplice_overlap = 0.0\n[[ply]]\nname = "B"\n'
+    text = JOB.replace("kinematic = false", "splice_overlap = 12.5\ndart_overlap = 3.0") + ply
+    job = parse(text)
+    assert job.laminate.splice_overlap == 12.5 and job.laminate.dart_overlap == 3.0
+    assert job.plies[0].splice_overlap == 0.0 and job.plies[1].splice_overlap is None
+    with pytest.raises(JobError, match=r"splice_overlap must be ≥ 0"):
+        parse(JOB.replace("kinematic = false", "splice_overlap = -1.0") + ply)
+    with pytest.raises(JobError, match=r"dart_overlap must be ≥ 0"):
+        parse(JOB + ply + "dart_overlap = -2.0\n")

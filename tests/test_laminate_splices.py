@@ -370,3 +370,62 @@ def test_splices_that_cannot_be_cut_are_refused_with_the_ply_named():
     )
     with pytest.raises(OptionsError, match="splices need a mould of triangles"):
         drape_laminate(quads, plies()[:1], kinematic=False)
+
+
+def _with_options(result, **changes):
+    """The laminate's result with its options changed (the drapes as they are)."""
+    options = result.laminate.options.replace(**changes)
+    laminate = type(result.laminate)(result.laminate.plies, options)
+    return type(result)(**{**result.__dict__, "laminate": laminate})
+
+
+def _offsets(blank, joints):
+    """Per edge of a piece's net outline: how far its trim line lies from the edge's middle, and
+    the piece across the edge (−1 on the mould's edge)."""
+    from shapely.geometry import LinearRing, Point
+
+    trim = LinearRing(blank.trim[0])
+    ring = blank.net[0]
+    middles = 0.5 * (ring + np.roll(ring, -1, axis=0))
+    return np.array([trim.distance(Point(m)) for m in middles]), joints
+
+
+def test_splices_butt_by_default_and_a_later_piece_laps_by_the_overlap(spliced):
+    """Along a splice a piece is cut to the line (butt), not grown by the trim allowance: two
+    pieces cut with it would overlap by twice the allowance. With ``splice_overlap`` each piece
+    laps over the pieces before it by the overlap. The mould's edge keeps the trim allowance."""
+    drape = spliced.drape("A")
+    pieces = drape.spliced
+    for overlap in (0.0, 0.3):
+        blanks = [b for b in ply_blanks(_with_options(spliced, splice_overlap=overlap))[:4]]
+        for index, blank in enumerate(blanks):
+            (joints,) = pieces.joints(index)  # (one loop: the piece's outline)
+            assert (joints >= 0).any() and (joints < 0).any()
+            # the net ring as the blank has it (counter-clockwise): its edges' pieces
+            if not np.allclose(blank.net[0], pieces.outline(index)[0]):
+                joints = np.roll(joints[::-1], -1)
+            distance, across = _offsets(blank, joints)
+            ring = blank.net[0]
+            length = np.linalg.norm(np.roll(ring, -1, axis=0) - ring, axis=1)
+            # edges away from the outline's corners (whose mitres reach further)
+            corner = np.zeros(len(ring), dtype=bool)
+            for k in np.flatnonzero(np.diff(np.concatenate([across, across[:1]])) != 0):
+                corner[[(k + d) % len(ring) for d in (-1, 0, 1, 2)]] = True
+            edge = (across < 0) & ~corner
+            before, after = (across >= 0) & (across < index) & ~corner, (across > index) & ~corner
+            assert np.allclose(distance[edge], 0.5, atol=1e-9)
+            assert np.allclose(distance[after], 0.0, atol=1e-9)
+            assert np.allclose(distance[before], overlap, atol=1e-9)
+            expected = sorted({int(j) for j in across[(across >= 0) & (across < index)]})
+            names = tuple(pieces.pieces[j].name for j in expected) if overlap else ()
+            assert blank.laps_over == names and blank.splice_overlap == overlap
+            # the trim area: the net's grown by the allowance along the mould's edge (and the
+            # overlap along the splices before it), never along the others
+            grown = blank.net_area + 0.5 * length[across < 0].sum()
+            grown += overlap * length[(across >= 0) & (across < index)].sum()
+            assert blank.trim_area == pytest.approx(grown, rel=0.05)
+        assert blanks[0].laps_over == () and (overlap == 0 or blanks[-1].laps_over)
+    # the other ply, cut whole, has the trim allowance all round
+    whole = ply_blanks(spliced)[4]
+    distance, _ = _offsets(whole, np.full(len(whole.net[0]), -1))
+    assert np.median(distance) == pytest.approx(0.5, abs=1e-9) and whole.laps_over == ()

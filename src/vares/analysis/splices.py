@@ -161,6 +161,34 @@ class SplicedPly:
                 ring[k] = weights @ flat[triangles[face]]
         return rings
 
+    def joints(self, index: int) -> list[np.ndarray]:
+        """Per boundary loop of piece ``index`` (in the order of :meth:`outline`'s rings) and
+        per edge ``k`` of it (from the loop's point ``k`` to the next, the last back to the
+        first): the index of the piece on the other side where the edge lies on a splice, else
+        −1 (the mould's edge). The pieces keep the cut mesh's points, so an edge on a splice is
+        an edge of the piece across it as well."""
+        from scipy.spatial import cKDTree
+
+        mesh = self.pieces[index].mesh
+        loops = mesh.boundary_loops()
+        others = [j for j in range(len(self.pieces)) if j != index]
+        if not others:
+            return [np.full(len(loop), -1) for loop in loops]
+        middles, owners = [], []
+        for j in others:
+            other = self.pieces[j].mesh
+            edges = other.boundary_edges()
+            middles.append(other.points[edges].mean(axis=1))
+            owners.append(np.full(len(edges), j))
+        tree, owner = cKDTree(np.vstack(middles)), np.concatenate(owners)
+        size = float(np.ptp(self.cut.mesh.points, axis=0).max())
+        out = []
+        for loop in loops:
+            middle = 0.5 * (mesh.points[loop] + mesh.points[np.roll(loop, -1)])
+            distance, nearest = tree.query(middle)
+            out.append(np.where(distance <= 1e-9 * size, owner[nearest], -1))
+        return out
+
     def cell_field(self, name: str) -> np.ndarray:
         """A per-cell field of the pieces' patterns on ``cut.mesh``'s cells ``(m, …)``."""
         first = np.asarray(self.results[0].fields[name])

@@ -117,6 +117,8 @@ class LaminateRun:
                     "trim_area": blank.trim_area,
                     "surface_area": blank.surface_area,
                     "trim_allowance": blank.allowance,
+                    "splice_overlap": blank.splice_overlap if blank.piece is not None else None,
+                    "laps_over": list(blank.laps_over),
                     "areal_weight": blank.areal_weight,
                     "thickness": blank.thickness,
                     "net_mass": blank.mass(blank.net_area, self.units),

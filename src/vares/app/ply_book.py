@@ -238,6 +238,23 @@ def _nest_section(nest: RollNest | None, blanks, units: str) -> list[str]:
     ]
 
 
+def _splices_text(blank, units: str) -> str:
+    """How a spliced piece meets the others: cut to the splice lines (butt), or lapping over
+    the pieces laid before it."""
+    if not blank.laps_over:
+        if blank.splice_overlap > 0:
+            return (
+                f"cut to its splice lines; the pieces after it lap over it by "
+                f"{number(blank.splice_overlap)} {units} (lay it first)"
+            )
+        return "butt: cut to its splice lines (no trim allowance there)"
+    them = "them" if len(blank.laps_over) > 1 else "it"
+    return (
+        f"laps {number(blank.splice_overlap)} {units} over {', '.join(blank.laps_over)} (lay "
+        f"it after {them}); cut to its splice lines with the pieces after it"
+    )
+
+
 def _ply_section(result, blank, check, units, figures: dict[tuple, list[str]]) -> list[str]:
     drape: PlyDrapeResult = result.drape(blank.name)
     ply = next(p for p in result.laminate.plies if p.name == blank.name)
@@ -254,6 +271,7 @@ def _ply_section(result, blank, check, units, figures: dict[tuple, list[str]]) -
         ("area on the mould", f"{number(blank.surface_area)} {units}²"),
         ("net area (flat)", f"{number(blank.net_area)} {units}²"),
         (f"blank area (trim +{blank.allowance:g} {units})", f"{number(blank.trim_area)} {units}²"),
+        *([("splices", _splices_text(blank, units))] if blank.piece is not None else []),
         ("mass of the net", _mass(blank, blank.net_area, units)),
         ("mass of the blank as cut", _mass(blank, blank.trim_area, units)),
         ("largest shear", f"{number(check.max_shear, 4)}°"),

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["MITRE_LIMIT", "allowance_outline", "cut_outline", "ring_area"]
+__all__ = ["MITRE_LIMIT", "allowance_outline", "cut_outline", "edge_outline", "ring_area"]
 
 #: Corners whose mitre would reach further than this many allowances are bevelled.
 MITRE_LIMIT = 4.0
@@ -34,6 +34,30 @@ def cut_outline(rings: Sequence[np.ndarray], allowance: float) -> list[np.ndarra
     polygon = Polygon(rings[outer], [r for k, r in enumerate(rings) if k != outer])
     if allowance > 0:
         polygon = polygon.buffer(allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
+    if polygon.geom_type != "Polygon":
+        polygon = max(polygon.geoms, key=lambda g: g.area)
+    polygon = orient(polygon, 1.0)
+    outline = [np.asarray(polygon.exterior.coords)[:-1]]
+    return outline + [np.asarray(r.coords)[:-1] for r in polygon.interiors]
+
+
+def edge_outline(
+    rings: Sequence[np.ndarray], allowances: Sequence[np.ndarray], hole_allowance: float
+) -> list[np.ndarray]:
+    """:func:`cut_outline` with an allowance per edge of the outline (``allowances[0]``, edge
+    ``i`` from ``rings[0][i]`` to the next; a ply's splices butt or lap where its mould's edge
+    has the trim allowance); the holes (``rings[1:]``) are shrunk by ``hole_allowance``. Where
+    every edge has the same allowance, :func:`cut_outline` itself."""
+    outer = np.asarray(allowances[0], dtype=float)
+    if np.all(outer == outer[0]) and (len(rings) == 1 or outer[0] == hole_allowance):
+        return cut_outline(rings, float(outer[0]))
+    from shapely.geometry import Polygon
+    from shapely.geometry.polygon import orient
+
+    polygon = Polygon(allowance_outline(rings[0], outer))
+    for hole in rings[1:]:
+        shrunk = Polygon(hole).buffer(-hole_allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
+        polygon = polygon.difference(shrunk) if not shrunk.is_empty else polygon
     if polygon.geom_type != "Polygon":
         polygon = max(polygon.geoms, key=lambda g: g.area)
     polygon = orient(polygon, 1.0)

@@ -3,8 +3,11 @@ ply's seed, areas and masses, and every ply nested on the roll (DESIGN.md §8).
 
 A ply's **net boundary** is its pattern's boundary (the part's edge, flat); its **extended
 boundary** is the net grown by ``trim_allowance`` (mesh units, mitred corners; the DXF's cut line,
-:func:`vares.geometry.outline.cut_outline`): the blank as cut, with the excess trimmed after
-draping. The **rosette** sits at the pattern point of the mould node
+:func:`vares.geometry.outline.cut_outline`) along the mould's edge: the blank as cut, with the
+excess trimmed after draping. A **joint** is not trimmed: along a splice each piece is cut to
+the line (butt), or laps over the pieces before it by ``splice_overlap``; a dart's lips are cut
+to the dart (butt), or its left lip laps over the right one by ``dart_overlap`` (and a notch the
+edges' allowances would close at its mouth is cut open again). The **rosette** sits at the pattern point of the mould node
 nearest the ply's seed, with the warp (0°) and the fill (90°) of the ply's pattern. Every pattern
 comes with its warp along +x, which is the roll's direction: the plies are nested as they are
 (or turned by 180°, which keeps the warp along the roll) by
@@ -25,13 +28,14 @@ the pattern's area.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
-from ..geometry.outline import MITRE_LIMIT, ring_area
+from ..geometry.outline import MITRE_LIMIT, edge_outline, ring_area
 from ..geometry.outline import cut_outline as extended_boundary
 from ..units import METRES
 from .laminate import LaminateResult
@@ -60,7 +64,8 @@ class PlyBlank:
     area of the ply on the mould; ``areal_weight`` (g/m²) and ``thickness`` (mm) when known;
     ``darts``: the open dart lines ``(k, 2)`` (both lips, mouth → tip → mouth), none undarted;
     ``piece``: the piece's name for a spliced ply (``None`` for a ply cut whole) and ``pieces``
-    how many the ply is cut into.
+    how many the ply is cut into; ``splice_overlap``: the ply's overlap at its splices (0: butt)
+    and ``laps_over``: the names of the pieces this one laps over by it (module docs).
     """
 
     name: str
@@ -82,6 +87,8 @@ class PlyBlank:
     darts: list[np.ndarray] = field(default_factory=list)
     piece: str | None = None
     pieces: int = 1
+    splice_overlap: float = 0.0
+    laps_over: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
@@ -112,24 +119,37 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
         drape = result.drape(ply.name)
         pieces = drape.pieces
         holder = _seed_piece(pieces, drape.seed) if len(pieces) > 1 else 0
+        o = ply.options
+        overlap = options.splice_overlap if o.splice_overlap is None else o.splice_overlap
+        dart_overlap = options.dart_overlap if o.dart_overlap is None else o.dart_overlap
         for index, (piece, mesh, pattern) in enumerate(pieces):
             coordinates = pattern.material_coordinates
-            key = (drape.label, piece)
+            key = (drape.label, piece, overlap, dart_overlap)
             if key not in outlines:  # the plies of one drape share its outlines
+                laps: list[int] = []
+                lips = []
                 if drape.is_spliced:  # along a splice: the line as drawn
                     loops = drape.spliced.outline(index)
+                    across = drape.spliced.joints(index)
+                    widths = [
+                        np.where(j < 0, allowance, np.where(j < index, overlap, 0.0))
+                        for j in across
+                    ]
+                    laps = sorted({int(j) for a in across for j in a[(a >= 0) & (a < index)]})
                 else:
-                    loops = [coordinates[loop] for loop in mesh.boundary_loops()]
-                loops.sort(key=lambda r: -abs(ring_area(r)))
-                net = [
-                    r if (ring_area(r) > 0) == (k == 0) else r[::-1] for k, r in enumerate(loops)
-                ]
-                outlines[key] = net, extended_boundary(net, allowance)
-            net, trim = outlines[key]
+                    nodes = mesh.boundary_loops()
+                    loops = [coordinates[loop] for loop in nodes]
+                    lips = drape.darted.slits.lips if drape.is_darted else []
+                    widths = [_lip_widths(loop, lips, allowance, dart_overlap) for loop in nodes]
+                net, trim = _outlines(loops, widths, allowance)
+                if lips:
+                    notches = [(coordinates[a], coordinates[b]) for a, b in lips]
+                    trim = _open_notches(net, trim, notches, allowance, dart_overlap)
+                outlines[key] = net, trim, laps if overlap > 0 else []
+            net, trim, laps = outlines[key]
             target = drape.seed if index == holder else mesh.points.mean(axis=0)
             node = int(np.argmin(np.linalg.norm(mesh.points - target, axis=1)))
             fibres = pattern.fibres
-            o = ply.options
             blanks.append(
                 PlyBlank(
                     name=ply.name,
@@ -151,9 +171,76 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
                     darts=drape.darted.dart_pattern_lines() if drape.is_darted else [],
                     piece=piece,
                     pieces=len(pieces),
+                    splice_overlap=overlap if drape.is_spliced else 0.0,
+                    laps_over=tuple(pieces[j][0] for j in laps),
                 )
             )
     return blanks
+
+
+def _outlines(loops, widths, allowance: float):
+    """A blank's net rings (the largest first and counter-clockwise, holes clockwise) and its
+    trim rings, from its boundary ``loops`` ``(k, 2)`` and the allowance of every edge of each
+    (edge ``i`` from point ``i`` to the next): the trim ``allowance`` on the mould's edge, a
+    splice's or a dart's own on a joint (module docs)."""
+    order = sorted(range(len(loops)), key=lambda k: -abs(ring_area(loops[k])))
+    net, edges = [], []
+    for rank, k in enumerate(order):
+        ring, width = loops[k], np.asarray(widths[k], dtype=float)
+        if (ring_area(ring) > 0) != (rank == 0):  # edge i of the reversed ring: n − 2 − i
+            ring, width = ring[::-1], np.roll(width[::-1], -1)
+        net.append(ring)
+        edges.append(width)
+    return net, edge_outline(net, edges, allowance)
+
+
+def _open_notches(net, trim, notches, allowance: float, overlap: float) -> list[np.ndarray]:
+    """The trim rings ``trim`` with every dart's notch cut open to the outside: where a notch is
+    narrower at its mouth than the trim allowance, the allowances of the edges beside the mouth
+    reach over it and close it. Cut out: the wedge between the lips and their lines on beyond
+    the mouth; put back: the net and the left lip's overlap (``notches``: per dart the left
+    and the right lip's points ``(k, 2)``, mouth to tip)."""
+    from shapely.geometry import Polygon
+    from shapely.geometry.polygon import orient
+    from shapely.ops import unary_union
+
+    reach = MITRE_LIMIT * allowance + overlap + 1.0e-9
+    region = Polygon(trim[0], trim[1:])
+    kept = [Polygon(net[0], net[1:])]
+    for left, right in notches:
+        beyond = [lip[0] + reach * (lip[0] - lip[1]) / np.linalg.norm(lip[0] - lip[1])
+                  for lip in (left, right)]  # fmt: skip
+        wedge = np.vstack([beyond[0], left, right[::-1], beyond[1]])
+        region = region.difference(Polygon(wedge).buffer(0))
+        if overlap > 0:  # the left lip's edges moved out by the overlap, towards the right lip
+            towards = right.mean(axis=0) - left.mean(axis=0)
+            for a, b in itertools.pairwise(left):
+                t = (b - a) / np.linalg.norm(b - a)
+                n = np.array([t[1], -t[0]])
+                n = n if n @ towards > 0 else -n
+                kept.append(Polygon([a, b, b + overlap * n, a + overlap * n]))
+    region = unary_union([region, *kept])
+    if region.geom_type != "Polygon":
+        region = max(region.geoms, key=lambda g: g.area)
+    region = orient(region, 1.0)
+    return [np.asarray(region.exterior.coords)[:-1]] + [
+        np.asarray(r.coords)[:-1] for r in region.interiors
+    ]
+
+
+def _lip_widths(loop: np.ndarray, lips, allowance: float, overlap: float) -> np.ndarray:
+    """The allowance of every edge of a darted blank's boundary ``loop`` (node indices): the
+    trim ``allowance`` but on the darts' lips, where the left lip laps over the right one by
+    ``overlap`` when the dart closes (0: the lips butt)."""
+    pairs = {}
+    for left, right in lips:
+        for chain, width in ((left, overlap), (right, 0.0)):
+            for u, v in itertools.pairwise(chain.tolist()):
+                pairs[(min(u, v), max(u, v))] = width
+    following = np.roll(loop, -1)
+    return np.array(
+        [pairs.get((min(u, v), max(u, v)), allowance) for u, v in zip(loop, following, strict=True)]
+    )
 
 
 def _seed_piece(pieces, seed: np.ndarray) -> int | None:

@@ -131,6 +131,24 @@ class LaminateOptions(Options):
         section="laminate",
         minimum=0.0,
     )
+    splice_overlap: float = option(
+        0.0,
+        "float",
+        "Overlap at the splices of every ply that names none, mesh length units: each piece "
+        "after the first laps over the pieces before it by this much (its edge along those "
+        "splices moved out); 0: butt splices, every piece cut to the splice line.",
+        section="laminate",
+        minimum=0.0,
+    )
+    dart_overlap: float = option(
+        0.0,
+        "float",
+        "Overlap at the darts of every ply that names none, mesh length units: a dart's left "
+        "lip (as the dart runs in from its mouth) laps over the right one by this much when it "
+        "closes; 0: the lips butt, both cut to the dart line.",
+        section="laminate",
+        minimum=0.0,
+    )
     roll_width: float | None = option(
         None,
         "float",
@@ -257,6 +275,22 @@ class PlyOptions(Options):
         help="Splice lines of the ply: a curves file (as dart_lines), each from the ply's boundary "
         "across it to the boundary; the ply is cut into pieces along them, each draped, cut and "
         "nested on its own (where darts cannot relieve the shear: negatively curved moulds).",
+    )
+    splice_overlap: float | None = option(
+        None,
+        "float",
+        "Overlap at the ply's splices, mesh length units: each piece after the first laps over "
+        "the pieces before it by this much; 0: butt splices (default: the laminate's).",
+        section="ply",
+        minimum=0.0,
+    )
+    dart_overlap: float | None = option(
+        None,
+        "float",
+        "Overlap at the ply's darts, mesh length units: the left lip laps over the right one by "
+        "this much; 0: the lips butt (default: the laminate's).",
+        section="ply",
+        minimum=0.0,
     )
     locking_angle: float | None = reused(
         DrapeOptions,
