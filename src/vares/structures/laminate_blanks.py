@@ -7,11 +7,11 @@ boundary** is the net grown by ``trim_allowance`` (mesh units, mitred corners; t
 excess trimmed after draping. A **joint** is not trimmed: along a splice each piece is cut to
 the line (butt), or laps over the pieces before it by ``splice_overlap``; a dart's lips are cut
 to the dart (butt), or its left lip laps over the right one by ``dart_overlap`` (and a notch the
-edges' allowances would close at its mouth is cut open again). The **rosette** sits at the pattern point of the mould node
-nearest the ply's seed, with the warp (0°) and the fill (90°) of the ply's pattern. Every pattern
-comes with its warp along +x, which is the roll's direction: the plies are nested as they are
-(or turned by 180°, which keeps the warp along the roll) by
-:func:`vares.structures.nesting.nest_pieces`.
+edges' allowances would close at its mouth is cut open again). The **rosette** sits at the
+pattern point of the mould node nearest the ply's seed, with the warp (0°) and the fill (90°)
+of the ply's pattern. Every pattern comes with its warp along +x, which is the roll's
+direction: the plies are nested as they are (or turned by 180°, which keeps the warp along the
+roll) by :func:`vares.structures.nesting.nest_pieces`.
 A darted ply's blank is its pattern opened along the darts: the darts' lips are part of its net
 boundary, and its ``darts`` are both lips of each, mouth → tip → mouth, in the pattern frame.
 A spliced ply is cut as several blanks, one per piece (in the order of the pieces, named
