@@ -9,8 +9,9 @@ centre there (weights: the shear beyond the locking angle); a region inside the 
 the boundary side nearest its most sheared cell.
 
 **Where the bisector leads nowhere** (a region inside the ply, whose cells between it and the
-boundary are sheared less than the tip angle; the corners of a box-shaped part), a dart runs
-along a **fall line** instead (:func:`fall_line_darts`): from the boundary up the slope of the
+boundary are sheared less than the tip angle: the corners of a box-shaped part), or its darts
+leave the shear at or beyond the locking angle, every region gets a dart along a **fall line**
+(:func:`fall_line_darts`), in rounds of their own: from the boundary up the slope of the
 mould to the positively curved patch beside the region (the excess fabric a dart takes out lies
 there; the region itself is often negatively curved, at the foot of a corner), and through it.
 The slope is that of the mould's draw direction, the mean of its cells' normals (the direction
