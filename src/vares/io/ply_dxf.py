@@ -7,7 +7,8 @@ Coordinates are the mesh's, in its units (``$INSUNITS``), each ply in its patter
 along +x). Layers:
 
 ``NET``      the net boundary (the part's edge): the pattern's boundary rings;
-``TRIM``     the extended boundary (the blank as cut: the net grown by the trim allowance);
+``TRIM``     the extended boundary (the blank as cut: the net grown by the trim allowance
+             along the mould's edge; at a splice or a dart's lips butt, or by its overlap);
 ``ROSETTE``  at the ply's seed: a circle, the 0° arrow along the warp and the 90° arrow along
              the fill, each with its angle as text;
 ``LABEL``    the ply's name, orientation and areas;
