@@ -12,6 +12,7 @@ from conftest import error_line, run
 from vares.analysis.darts import (
     darts_from_polylines,
     erected_yarns,
+    fall_line_darts,
     place_darts,
     smoothed,
     solve_with_darts,
@@ -401,8 +402,6 @@ def test_the_corners_of_a_cup_get_darts_along_their_fall_lines(square_cup_patter
     edge shear less than the tip angle), a dart runs from the flange's edge up the fall line
     through the corner's positively curved patch onto the punch face: one per corner, and with
     them open the shear is below the locking angle."""
-    from vares.analysis.darts import fall_line_darts
-
     mesh, law, before = square_cup_pattern
     shear = before.fields["shear_angle"]
     assert before.converged and np.nanmax(np.abs(shear)) >= LOCKING
@@ -428,14 +427,15 @@ def test_the_corners_of_a_cup_get_darts_along_their_fall_lines(square_cup_patter
     assert darted.after.converged and darted.kept and darted.relieved
     assert darted.max_shear_after < 0.7 * LOCKING  # 29.9° against 55.5° without darts
     assert [r.rule for r in darted.rounds] == ["fall line"]  # the bisector placed none
+    from vares.app.cli.drape import darts_verdict
+
+    assert "with the darts open (placed along the mould's fall lines)" in darts_verdict(darted)
 
 
 def test_fall_line_darts_move_with_the_mould(square_cup_pattern):
     """The draw direction is the mould's own (its cells' mean normal): a rigid motion of the
     mould moves the fall lines' darts with it."""
     from conftest import rotation
-
-    from vares.analysis.darts import fall_line_darts
 
     mesh, _, before = square_cup_pattern
     shear = before.fields["shear_angle"]
@@ -446,7 +446,35 @@ def test_fall_line_darts_move_with_the_mould(square_cup_pattern):
     for line, other in zip(found[0], found[1], strict=True):
         assert np.isclose(line.length, other.length, rtol=1e-9)
         assert np.allclose(line.points @ turn.T + shift, other.points, atol=1e-8)
-    closed = SurfaceMesh(  # a closed surface has no draw direction: no fall line
-        mesh.points * [1, 1, 0], mesh.cells
-    )
-    assert fall_line_darts(closed, shear, LOCKING, 0.8 * LOCKING) == []
+
+
+def test_a_nearly_closed_mould_has_no_fall_lines(monkeypatch):
+    """A sphere less one triangle has no draw direction (its area vectors add up to 0.05 % of
+    its area): no fall-line dart, where the same sheared region on the open hemisphere gets one
+    (and the sphere gets one too when the draw direction is not asked for)."""
+    import vares.analysis.darts as darts
+    from vares.geometry.hard_surfaces import spherical_cap
+
+    cap = spherical_cap(R, 90.0, 12)
+    points, triangles = cap.points, cap.cells["triangle"]
+    twin = np.arange(len(points)) + len(points)  # the lower half's nodes, the equator shared
+    equator = np.flatnonzero(np.abs(points[:, 2]) < 1e-9)
+    twin[equator] = equator
+    cells = np.vstack([triangles, twin[triangles][:, ::-1]])[1:]  # less a triangle at the pole
+    used = np.unique(cells)
+    number = np.full(2 * len(points), -1)
+    number[used] = np.arange(len(used))
+    both = np.vstack([points, points * [1, 1, -1]])
+    sphere = SurfaceMesh(both[used], {"triangle": number[cells]})
+
+    def shear_of(mesh):  # 60° on a patch of the upper half about the 45° meridian
+        middle = mesh.points[mesh.cells["triangle"]].mean(axis=1)
+        azimuth = np.degrees(np.arctan2(middle[:, 1], middle[:, 0]))
+        band = (np.abs(azimuth - 45.0) < 15.0) & (middle[:, 2] > 10.0) & (middle[:, 2] < 50.0)
+        return np.where(band, 60.0, 0.0)
+
+    (line,) = fall_line_darts(cap, shear_of(cap), LOCKING, 0.8 * LOCKING)
+    assert abs(line.points[0, 2]) < 1e-9  # its mouth on the equator
+    assert fall_line_darts(sphere, shear_of(sphere), LOCKING, 0.8 * LOCKING) == []
+    monkeypatch.setattr(darts, "DRAWN", 0.0)
+    assert len(fall_line_darts(sphere, shear_of(sphere), LOCKING, 0.8 * LOCKING)) == 1

@@ -165,6 +165,7 @@ def test_ply_book_shows_the_darts(darted):
     summary = re.search(r"<p id='darts-A'>(.*?)</p>", text, re.S).group(1)
     assert f"{a.max_shear_before:.4g}°" in summary and f"{a.max_shear_after:.4g}°" in summary
     assert "below the locking angle" in summary
+    assert "The lips butt" in summary  # (no dart_overlap)
     assert "No darts needed" in re.search(r"<p id='darts-B'>(.*?)</p>", text, re.S).group(1)
 
 
@@ -358,8 +359,12 @@ def test_dart_lips_butt_by_default_and_the_left_lip_laps_by_the_overlap(darted):
         options = darted.laminate.options.replace(dart_overlap=overlap)
         laminate = type(darted.laminate)(darted.laminate.plies, options)
         result = type(darted)(**{**darted.__dict__, "laminate": laminate})
-        blank = ply_blanks(result)[0]
-        assert blank.name == "A" and blank.darts
+        blanks = ply_blanks(result)
+        blank = blanks[0]
+        assert blank.name == "A" and blank.darts and blank.dart_overlap == overlap
+        if overlap:
+            text = ply_book(result, blanks, None, units="mm")
+            assert "left lip (from its mouth in) laps 0.02 mm over the right one" in text
         trim = LinearRing(blank.trim[0])
         for left, right in lips:
             for chain, expected in ((left, overlap), (right, 0.0)):

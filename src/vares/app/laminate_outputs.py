@@ -119,6 +119,7 @@ class LaminateRun:
                     "trim_allowance": blank.allowance,
                     "splice_overlap": blank.splice_overlap if blank.piece is not None else None,
                     "laps_over": list(blank.laps_over),
+                    "dart_overlap": blank.dart_overlap if blank.darts else None,
                     "areal_weight": blank.areal_weight,
                     "thickness": blank.thickness,
                     "net_mass": blank.mass(blank.net_area, self.units),

@@ -299,7 +299,7 @@ def _ply_section(result, blank, check, units, figures: dict[tuple, list[str]]) -
         if blank.piece == drape.spliced.pieces[0].name:  # the whole ply's picture, once
             lines += [part.replace("{ply}", ident) for part in figures[drape.label, "splices"]]
     else:
-        lines = ["<h3>Darts</h3>", *_darts_part(drape, check, ident, units)]
+        lines = ["<h3>Darts</h3>", *_darts_part(drape, check, ident, units, blank.dart_overlap)]
     return [
         f"<section class='ply' id='ply-{ident}'>",
         f"<h2>Ply {heading}: {blank.orientation:+g}°</h2>",
@@ -357,9 +357,12 @@ def _curvature_advice(darted) -> str:
     )
 
 
-def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: str) -> list[str]:
-    """The ply's darts: a table of their lengths and openings and the largest shear before and
-    after; or, without darts, how much of the ply is at or beyond the locking angle."""
+def _darts_part(
+    drape: PlyDrapeResult, check: Producibility, ident: str, units: str, overlap: float = 0.0
+) -> list[str]:
+    """The ply's darts: a table of their lengths and openings, the largest shear before and
+    after and how the lips meet (``overlap``: the left lip's over the right one, 0: butt); or,
+    without darts, how much of the ply is at or beyond the locking angle."""
     limit = 100 * check.fractions["limit"]
     darted = drape.darted
     if darted is not None and darted.after is not None and not drape.is_darted:
@@ -404,7 +407,13 @@ def _darts_part(drape: PlyDrapeResult, check: Producibility, ident: str, units: 
         f"{len(rows)} dart(s), {len(darted.rounds)} solve(s) with darts: the largest shear "
         f"{number(darted.max_shear_before, 4)}° without darts, {number(after, 4)}° with them "
         f"open, {state} the locking angle ({number(darted.locking_angle, 4)}°); "
-        f"{limit:.1f} % of the blank's area is at or beyond it."
+        f"{limit:.1f} % of the blank's area is at or beyond it. "
+        + (
+            f"Each dart's left lip (from its mouth in) laps {number(overlap)} {units} over the "
+            "right one."
+            if overlap > 0
+            else "The lips butt: both cut to the dart line."
+        )
     )
     return [
         f"<p id='darts-{ident}'>{html.escape(text)}</p>",

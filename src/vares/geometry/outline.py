@@ -9,7 +9,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["MITRE_LIMIT", "allowance_outline", "cut_outline", "edge_outline", "ring_area"]
+__all__ = [
+    "MITRE_LIMIT",
+    "allowance_outline",
+    "cut_outline",
+    "edge_outline",
+    "region_rings",
+    "ring_area",
+]
 
 #: Corners whose mitre would reach further than this many allowances are bevelled.
 MITRE_LIMIT = 4.0
@@ -28,17 +35,24 @@ def cut_outline(rings: Sequence[np.ndarray], allowance: float) -> list[np.ndarra
     out): its rings ``(k, 2)``, not closed, the outline first and counter-clockwise, then what
     is left of the holes, clockwise. Of a region in several pieces the largest is kept."""
     from shapely.geometry import Polygon
-    from shapely.geometry.polygon import orient
 
     outer = max(range(len(rings)), key=lambda k: abs(ring_area(rings[k])))
     polygon = Polygon(rings[outer], [r for k, r in enumerate(rings) if k != outer])
     if allowance > 0:
         polygon = polygon.buffer(allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
-    if polygon.geom_type != "Polygon":
-        polygon = max(polygon.geoms, key=lambda g: g.area)
-    polygon = orient(polygon, 1.0)
-    outline = [np.asarray(polygon.exterior.coords)[:-1]]
-    return outline + [np.asarray(r.coords)[:-1] for r in polygon.interiors]
+    return region_rings(polygon)
+
+
+def region_rings(region) -> list[np.ndarray]:
+    """The rings ``(k, 2)`` of a shapely region (of a region in several pieces, the largest),
+    not closed: the outline first and counter-clockwise, then its holes, clockwise."""
+    from shapely.geometry.polygon import orient
+
+    if region.geom_type != "Polygon":
+        region = max(region.geoms, key=lambda g: g.area)
+    region = orient(region, 1.0)
+    outline = [np.asarray(region.exterior.coords)[:-1]]
+    return outline + [np.asarray(r.coords)[:-1] for r in region.interiors]
 
 
 def edge_outline(
@@ -52,17 +66,12 @@ def edge_outline(
     if np.all(outer == outer[0]) and (len(rings) == 1 or outer[0] == hole_allowance):
         return cut_outline(rings, float(outer[0]))
     from shapely.geometry import Polygon
-    from shapely.geometry.polygon import orient
 
     polygon = Polygon(allowance_outline(rings[0], outer))
     for hole in rings[1:]:
         shrunk = Polygon(hole).buffer(-hole_allowance, join_style="mitre", mitre_limit=MITRE_LIMIT)
         polygon = polygon.difference(shrunk) if not shrunk.is_empty else polygon
-    if polygon.geom_type != "Polygon":
-        polygon = max(polygon.geoms, key=lambda g: g.area)
-    polygon = orient(polygon, 1.0)
-    outline = [np.asarray(polygon.exterior.coords)[:-1]]
-    return outline + [np.asarray(r.coords)[:-1] for r in polygon.interiors]
+    return region_rings(polygon)
 
 
 def allowance_outline(ring: np.ndarray, allowances: Sequence[float] | np.ndarray) -> np.ndarray:

@@ -28,14 +28,13 @@ the pattern's area.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..geometry.mesh import SurfaceMesh
-from ..geometry.outline import MITRE_LIMIT, edge_outline, ring_area
+from ..geometry.outline import MITRE_LIMIT, edge_outline, region_rings, ring_area
 from ..geometry.outline import cut_outline as extended_boundary
 from ..units import METRES
 from .laminate import LaminateResult
@@ -65,7 +64,8 @@ class PlyBlank:
     ``darts``: the open dart lines ``(k, 2)`` (both lips, mouth → tip → mouth), none undarted;
     ``piece``: the piece's name for a spliced ply (``None`` for a ply cut whole) and ``pieces``
     how many the ply is cut into; ``splice_overlap``: the ply's overlap at its splices (0: butt)
-    and ``laps_over``: the names of the pieces this one laps over by it (module docs).
+    and ``laps_over``: the names of the pieces this one laps over by it; ``dart_overlap``: a
+    darted ply's overlap of its darts' left lips (0: butt; module docs).
     """
 
     name: str
@@ -89,6 +89,7 @@ class PlyBlank:
     pieces: int = 1
     splice_overlap: float = 0.0
     laps_over: tuple[str, ...] = ()
+    dart_overlap: float = 0.0
 
     @property
     def label(self) -> str:
@@ -136,11 +137,10 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
                         for j in across
                     ]
                     laps = sorted({int(j) for a in across for j in a[(a >= 0) & (a < index)]})
-                else:
-                    nodes = mesh.boundary_loops()
-                    loops = [coordinates[loop] for loop in nodes]
+                else:  # (a dart's lips butt or lap: the notches cut open below)
+                    loops = [coordinates[loop] for loop in mesh.boundary_loops()]
+                    widths = [np.full(len(loop), allowance) for loop in loops]
                     lips = drape.darted.slits.lips if drape.is_darted else []
-                    widths = [_lip_widths(loop, lips, allowance, dart_overlap) for loop in nodes]
                 net, trim = _outlines(loops, widths, allowance)
                 if lips:
                     notches = [(coordinates[a], coordinates[b]) for a, b in lips]
@@ -173,6 +173,7 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
                     pieces=len(pieces),
                     splice_overlap=overlap if drape.is_spliced else 0.0,
                     laps_over=tuple(pieces[j][0] for j in laps),
+                    dart_overlap=dart_overlap if drape.is_darted else 0.0,
                 )
             )
     return blanks
@@ -195,13 +196,13 @@ def _outlines(loops, widths, allowance: float):
 
 
 def _open_notches(net, trim, notches, allowance: float, overlap: float) -> list[np.ndarray]:
-    """The trim rings ``trim`` with every dart's notch cut open to the outside: where a notch is
-    narrower at its mouth than the trim allowance, the allowances of the edges beside the mouth
-    reach over it and close it. Cut out: the wedge between the lips and their lines on beyond
-    the mouth; put back: the net and the left lip's overlap (``notches``: per dart the left
-    and the right lip's points ``(k, 2)``, mouth to tip)."""
-    from shapely.geometry import Polygon
-    from shapely.geometry.polygon import orient
+    """The trim rings ``trim`` (the net grown by ``allowance`` all round) with every dart's
+    lips butt, or the left one lapping over the right one by ``overlap``: cut out the wedge
+    between the lips and their lines on beyond the mouth (the allowance grown into the notch,
+    and over its mouth where the notch is narrower there than the allowance), put back the net
+    and the left lip's overlap (``notches``: per dart the left and the right lip's points
+    ``(k, 2)``, mouth to tip)."""
+    from shapely.geometry import LineString, Polygon
     from shapely.ops import unary_union
 
     reach = MITRE_LIMIT * allowance + overlap + 1.0e-9
@@ -210,37 +211,14 @@ def _open_notches(net, trim, notches, allowance: float, overlap: float) -> list[
     for left, right in notches:
         beyond = [lip[0] + reach * (lip[0] - lip[1]) / np.linalg.norm(lip[0] - lip[1])
                   for lip in (left, right)]  # fmt: skip
-        wedge = np.vstack([beyond[0], left, right[::-1], beyond[1]])
-        region = region.difference(Polygon(wedge).buffer(0))
-        if overlap > 0:  # the left lip's edges moved out by the overlap, towards the right lip
-            towards = right.mean(axis=0) - left.mean(axis=0)
-            for a, b in itertools.pairwise(left):
-                t = (b - a) / np.linalg.norm(b - a)
-                n = np.array([t[1], -t[0]])
-                n = n if n @ towards > 0 else -n
-                kept.append(Polygon([a, b, b + overlap * n, a + overlap * n]))
-    region = unary_union([region, *kept])
-    if region.geom_type != "Polygon":
-        region = max(region.geoms, key=lambda g: g.area)
-    region = orient(region, 1.0)
-    return [np.asarray(region.exterior.coords)[:-1]] + [
-        np.asarray(r.coords)[:-1] for r in region.interiors
-    ]
-
-
-def _lip_widths(loop: np.ndarray, lips, allowance: float, overlap: float) -> np.ndarray:
-    """The allowance of every edge of a darted blank's boundary ``loop`` (node indices): the
-    trim ``allowance`` but on the darts' lips, where the left lip laps over the right one by
-    ``overlap`` when the dart closes (0: the lips butt)."""
-    pairs = {}
-    for left, right in lips:
-        for chain, width in ((left, overlap), (right, 0.0)):
-            for u, v in itertools.pairwise(chain.tolist()):
-                pairs[(min(u, v), max(u, v))] = width
-    following = np.roll(loop, -1)
-    return np.array(
-        [pairs.get((min(u, v), max(u, v)), allowance) for u, v in zip(loop, following, strict=True)]
-    )
+        wedge = Polygon(np.vstack([beyond[0], left, right[::-1], beyond[1]])).buffer(0)
+        region = region.difference(wedge)
+        if overlap > 0:  # the band along the left lip, on the notch's side
+            band = LineString(left).buffer(
+                overlap, cap_style="flat", join_style="mitre", mitre_limit=MITRE_LIMIT
+            )
+            kept.append(band.intersection(wedge))
+    return region_rings(unary_union([region, *kept]))
 
 
 def _seed_piece(pieces, seed: np.ndarray) -> int | None:

@@ -405,7 +405,9 @@ def darts_verdict(darted) -> str:
     if after is None:
         tail = "no dart needed" if before < darted.locking_angle else "no dart placed"
     else:
-        tail = f"{after:.2f}° with the darts open"
+        fall = summary["chosen_rule"] == "fall line"
+        by = " (placed along the mould's fall lines)" if fall else ""
+        tail = f"{after:.2f}° with the darts open{by}"
     state = "below" if darted.relieved else "NOT below"
     solves = len(darted.rounds)
     verdict = (
