@@ -350,6 +350,7 @@ def test_dart_lips_butt_by_default_and_the_left_lip_laps_by_the_overlap(darted):
     would overlap by twice the allowance."""
     from shapely.geometry import LinearRing, Point, Polygon
 
+    from vares.geometry.surface_lines import CuttingError
     from vares.structures.laminate_blanks import ply_blanks
 
     drape = darted.drape("A")
@@ -386,6 +387,10 @@ def test_dart_lips_butt_by_default_and_the_left_lip_laps_by_the_overlap(darted):
         distance = np.array([trim.distance(Point(m)) for m in middles])
         assert np.median(distance) == pytest.approx(0.5, abs=1e-9)  # the mould's edge
         assert Polygon(blank.trim[0]).contains(Polygon(blank.net[0]).buffer(-1e-9))
+    options = darted.laminate.options.replace(dart_overlap=6.0)  # the cap is 10 across
+    laminate = type(darted.laminate)(darted.laminate.plies, options)
+    with pytest.raises(CuttingError, match=r"ply A: dart_overlap = 6 is half as wide"):
+        ply_blanks(type(darted)(**{**darted.__dict__, "laminate": laminate}))
 
 
 def test_joint_overlaps_are_read_from_a_job_file_and_checked():

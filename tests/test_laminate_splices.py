@@ -425,6 +425,9 @@ def test_splices_butt_by_default_and_a_later_piece_laps_by_the_overlap(spliced):
             grown += overlap * length[(across >= 0) & (across < index)].sum()
             assert blank.trim_area == pytest.approx(grown, rel=0.05)
         assert blanks[0].laps_over == () and (overlap == 0 or blanks[-1].laps_over)
+    # an overlap as wide as half a piece is no strip beside a splice: refused, naming the ply
+    with pytest.raises(CuttingError, match=r"ply A: splice_overlap = 3 is half as wide as its"):
+        ply_blanks(_with_options(spliced, splice_overlap=3.0))
     # the other ply, cut whole, has the trim allowance all round
     whole = ply_blanks(spliced)[4]
     distance, _ = _offsets(whole, np.full(len(whole.net[0]), -1))

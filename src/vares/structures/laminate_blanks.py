@@ -36,6 +36,7 @@ import numpy as np
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.outline import MITRE_LIMIT, edge_outline, region_rings, ring_area
 from ..geometry.outline import cut_outline as extended_boundary
+from ..geometry.surface_lines import CuttingError
 from ..units import METRES
 from .laminate import LaminateResult
 from .nesting import RollNest, nest_pieces, usable_width
@@ -123,6 +124,10 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
         o = ply.options
         overlap = options.splice_overlap if o.splice_overlap is None else o.splice_overlap
         dart_overlap = options.dart_overlap if o.dart_overlap is None else o.dart_overlap
+        if drape.is_spliced:
+            _check_overlap(ply.name, "splice_overlap", overlap, pieces)
+        elif drape.is_darted:
+            _check_overlap(ply.name, "dart_overlap", dart_overlap, pieces)
         for index, (piece, mesh, pattern) in enumerate(pieces):
             coordinates = pattern.material_coordinates
             key = (drape.label, piece, overlap, dart_overlap)
@@ -177,6 +182,22 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
                 )
             )
     return blanks
+
+
+def _check_overlap(ply: str, key: str, overlap: float, pieces) -> None:
+    """Refuse an overlap at a ply's joints of half its narrowest piece's width or more (its
+    flat extent across the warp or along it, whichever is less): a lap is a strip beside the
+    joint, not a second piece."""
+    if not overlap > 0:
+        return
+    extents = [np.ptp(p.pattern.material_coordinates, axis=0).min() for p in pieces]
+    k = int(np.argmin(extents))
+    if overlap >= 0.5 * extents[k]:
+        which = f"its {pieces[k].piece}" if pieces[k].piece is not None else "its blank"
+        raise CuttingError(
+            f"ply {ply}: {key} = {overlap:g} is half as wide as {which} ({extents[k]:.4g} "
+            "wide, mesh units) or more: an overlap is a strip beside the joint"
+        )
 
 
 def _outlines(loops, widths, allowance: float):
