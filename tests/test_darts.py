@@ -274,20 +274,38 @@ def test_drape_command_with_dart_lines(tmp_path):
     out = tmp_path / "out"
     base = ["drape", surface, "--seed", "0,0,100", "--warp", "1,0,0", "--spacing", 4, "-o", out]
     ncf = ["--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
-    result = run(*base, "--dart-lines", curves, *ncf, "--report")
+    edges = ["--trim-allowance", "5", "--dart-overlap", "3"]
+    result = run(*base, "--dart-lines", curves, *ncf, *edges, "--report")
     assert result.exit_code == 0, result.stderr
-    data = json.loads((out / "drape.json").read_text())["darts"]
+    drape = json.loads((out / "drape.json").read_text())
+    data = drape["darts"]
     assert data["darts"] == 4 and data["max_shear_after"] < data["max_shear_before"] - 4.0
     assert min(data["mouth_openings"]) > 10.0
     entities = list(ezdxf.readfile(out / "pattern.dxf").modelspace())
     layers = [e.dxf.layer for e in entities]
-    assert layers.count("DART") == 4 and layers.count("SEAM") == 1
+    assert layers.count("DART") == 4 and layers.count("SEAM") == 1 and layers.count("CUT") == 1
     (seam,) = [np.array(e.get_points("xy")) for e in entities if e.dxf.layer == "SEAM"]
     for dart in (np.array(e.get_points("xy")) for e in entities if e.dxf.layer == "DART"):
         # both lips are pieces of the pattern's outline, apart at the mouth, one at the tip
         nearest = np.linalg.norm(dart[:, None, :] - seam[None, :, :], axis=2).min(axis=1)
         assert nearest.max() < 1e-9
         assert np.linalg.norm(dart[0] - dart[-1]) > 10.0
+    # the cut line: 5 outside the net along the mould's edge, on each dart's right lip (butt),
+    # 3 beside its left lip (the lap), nowhere inside the net
+    from shapely.geometry import LineString, Point, Polygon
+
+    (cut,) = [np.array(e.get_points("xy")) for e in entities if e.dxf.layer == "CUT"]
+    net, trim = Polygon(seam), Polygon(cut)
+    assert trim.contains(net.buffer(-1e-6)) and trim.area > net.area
+    away = np.array([net.exterior.distance(Point(p)) for p in cut])
+    assert np.sum(np.abs(away - 5.0) < 1e-6) > 20 and np.sum(np.abs(away - 3.0) < 1e-6) >= 8
+    lips = [np.array(e.get_points("xy")) for e in entities if e.dxf.layer == "DART"]
+    near_lips = min(LineString(lip).distance(Point(p)) for lip in lips for p in cut)
+    assert near_lips < 1e-9  # the butt lips are cut to the dart
+    blank = drape["blank"]
+    assert (blank["trim_allowance"], blank["dart_overlap"]) == (5.0, 3.0)
+    assert blank["pieces"][0]["trim_area"] == pytest.approx(trim.area, rel=1e-9)
+    assert blank["pieces"][0]["net_area"] == pytest.approx(net.area, rel=1e-9)
     opened = meshio.read(out / "darts.vtu")
     assert len(opened.points) > mesh.num_points
     assert (out / "darts.png").stat().st_size > 10_000
@@ -324,6 +342,16 @@ def test_drape_command_with_dart_lines(tmp_path):
     assert not (tmp_path / "refused").exists()
     refused = run(*base[:-1], tmp_path / "refused", *ncf)
     assert refused.exit_code == 2 and "add --darts auto" in error_line(refused)
+    # an allowance without a cutter file, an overlap without its joints, or one as wide as
+    # half the blank: refused before anything is solved or written
+    for extra, message in [
+        (["--trim-allowance", "5"], "--trim-allowance is for the cutter files"),
+        (["--dart-lines", curves, *ncf, "--splice-overlap", "5"], "add --splice-lines"),
+        (["--dart-lines", curves, *ncf, "--dart-overlap", "1000"], "half as wide as its blank"),
+    ]:
+        refused = run(*base[:-1], tmp_path / "refused", *extra)
+        assert refused.exit_code == 2 and message in error_line(refused), refused.stderr
+        assert not (tmp_path / "refused").exists()
     refused = run(*base[:-1], tmp_path / "refused", "--darts", "auto", "--material", "neo-hooke")
     assert refused.exit_code == 2 and "yarns" in error_line(refused)
 

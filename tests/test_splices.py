@@ -277,8 +277,10 @@ def test_drape_command_with_splice_lines(tmp_path):
     fabric = ["--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
     out = tmp_path / "out"
     common = ["drape", "--example", "double-dome", "--splice-lines", lines]
-    result = run(*common, *fabric, "-o", out, "--report")
+    edges = ["--trim-allowance", "5", "--splice-overlap", "10"]
+    result = run(*common, *fabric, *edges, "-o", out, "--report")
     assert result.exit_code == 0, result.stderr
+    blank = json.loads((out / "drape.json").read_text())["blank"]
     data = json.loads((out / "drape.json").read_text())["splices"]
     assert data["relieved"] and len(data["pieces"]) == 2
     assert data["max_shear_before"] > 55.0 and data["max_shear_after"] < 35.0
@@ -308,6 +310,22 @@ def test_drape_command_with_splice_lines(tmp_path):
         cross = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
         turns = np.sort(np.abs(np.degrees(np.arctan2(cross, (before * after).sum(1)))))
         assert turns[-3] < 25.0 < turns[-2]
+    # the cut lines: 5 outside the net along the mould's edge; along the splice the first
+    # piece butt (cut to the line), the second lapping over it by 10
+    from shapely.geometry import Point, Polygon
+
+    seams = [np.array(e.get_points("xy")) for e in space if e.dxf.layer == "SEAM"]
+    cuts = [np.array(e.get_points("xy")) for e in space if e.dxf.layer == "CUT"]
+    for k, (seam, cut) in enumerate(zip(seams, cuts, strict=True)):
+        net, trim = Polygon(seam), Polygon(cut)
+        assert trim.contains(net.buffer(-1e-6))
+        away = np.array([net.exterior.distance(Point(p)) for p in cut])
+        assert np.sum(np.abs(away - 5.0) < 1e-6) > 20
+        assert (np.sum(away < 1e-9) > 5) == (k == 0) and (
+            np.sum(np.abs(away - 10.0) < 1e-6) > 5
+        ) == (k == 1)
+        assert blank["pieces"][k]["trim_area"] == pytest.approx(trim.area, rel=1e-9)
+    assert blank["splice_overlap"] == 10.0
     refused = run(*common, *fabric, "--darts", "auto", "-o", tmp_path / "both")
     assert refused.exit_code == 2
     assert "give darts or --splice-lines, not both" in error_line(refused)

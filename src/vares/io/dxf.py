@@ -46,10 +46,11 @@ class CutPiece:
     """One pattern to draw: coordinates ``(n, 2)`` in model units, warp direction ``(2,)``,
     label lines, optionally match mark positions (model units, ``(k, 2)``, on the seam line)
     that replace the regularly spaced ones, optionally its cut line (a ring ``(k, 2)`` in
-    model units, e.g. with an allowance per edge) that replaces the seam line grown by the
-    drawing's allowance, its darts (open polylines ``(k, 2)`` in model units, drawn on
-    layer ``DART``), and optionally its seam rings (``(k, 2)`` each, model units) that replace
-    the mesh's boundary loops (a spliced piece's edges on the drawn splice line)."""
+    model units, e.g. with an allowance per edge, or a list of rings: the outline, then holes)
+    that replaces the seam line grown by the drawing's allowance, its darts (open polylines
+    ``(k, 2)`` in model units, drawn on layer ``DART``), and optionally its seam rings
+    (``(k, 2)`` each, model units) that replace the mesh's boundary loops (a spliced piece's
+    edges on the drawn splice line)."""
 
     name: str
     mesh: SurfaceMesh
@@ -57,7 +58,7 @@ class CutPiece:
     warp: np.ndarray | None = None
     label: Sequence[str] = ()
     marks: np.ndarray | None = field(default=None, repr=False)
-    cut: np.ndarray | None = field(default=None, repr=False)
+    cut: np.ndarray | Sequence[np.ndarray] | None = field(default=None, repr=False)
     darts: Sequence[np.ndarray] = field(default=(), repr=False)
     seams: Sequence[np.ndarray] | None = field(default=None, repr=False)
 
@@ -119,7 +120,8 @@ def write_dxf(
         else:
             seams = [coordinates[loop] for loop in piece.mesh.boundary_loops()]
         if piece.cut is not None:
-            cuts = [np.asarray(piece.cut, dtype=float) * factor]
+            rings = [piece.cut] if np.ndim(piece.cut[0]) == 1 else piece.cut  # one ring, or rings
+            cuts = [np.asarray(r, dtype=float) * factor for r in rings]
         else:
             cuts = cut_outline(seams, allowance)
         everything = np.vstack(cuts + seams)

@@ -30,20 +30,29 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from ..analysis.darts import DartedPattern
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.outline import MITRE_LIMIT, edge_outline, region_rings, ring_area
 from ..geometry.outline import cut_outline as extended_boundary
 from ..geometry.surface_lines import CuttingError
 from ..units import METRES
+from .blank_options import BlankOptions
 from .laminate import LaminateResult
+from .laminate_plies import BlankPiece
 from .nesting import RollNest, nest_pieces, usable_width
+
+if TYPE_CHECKING:
+    from ..analysis.splices import SplicedPly
 
 __all__ = [
     "MITRE_LIMIT",
+    "BlankOutline",
     "PlyBlank",
+    "blank_outlines",
     "extended_boundary",
     "nest_plies",
     "ply_blanks",
@@ -116,7 +125,7 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
     options = result.laminate.options
     allowance = float(options.trim_allowance)
     blanks = []
-    outlines: dict[tuple, tuple[list[np.ndarray], list[np.ndarray]]] = {}  # per drape and piece
+    outlines: dict[tuple, list[BlankOutline]] = {}  # per drape and overlaps
     for ply in result.laminate.plies:
         drape = result.drape(ply.name)
         pieces = drape.pieces
@@ -124,34 +133,16 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
         o = ply.options
         overlap = options.splice_overlap if o.splice_overlap is None else o.splice_overlap
         dart_overlap = options.dart_overlap if o.dart_overlap is None else o.dart_overlap
-        if drape.is_spliced:
-            _check_overlap(ply.name, "splice_overlap", overlap, pieces)
-        elif drape.is_darted:
-            _check_overlap(ply.name, "dart_overlap", dart_overlap, pieces)
+        key = (drape.label, overlap, dart_overlap)
+        if key not in outlines:  # the plies of one drape share its outlines
+            edges = BlankOptions(
+                trim_allowance=allowance, splice_overlap=overlap, dart_overlap=dart_overlap
+            )
+            darted = drape.darted if drape.is_darted else None
+            outlines[key] = blank_outlines(pieces, edges, drape.spliced, darted, ply.name)
         for index, (piece, mesh, pattern) in enumerate(pieces):
             coordinates = pattern.material_coordinates
-            key = (drape.label, piece, overlap, dart_overlap)
-            if key not in outlines:  # the plies of one drape share its outlines
-                laps: list[int] = []
-                lips = []
-                if drape.is_spliced:  # along a splice: the line as drawn
-                    loops = drape.spliced.outline(index)
-                    across = drape.spliced.joints(index)
-                    widths = [
-                        np.where(j < 0, allowance, np.where(j < index, overlap, 0.0))
-                        for j in across
-                    ]
-                    laps = sorted({int(j) for a in across for j in a[(a >= 0) & (a < index)]})
-                else:  # (a dart's lips butt or lap: the notches cut open below)
-                    loops = [coordinates[loop] for loop in mesh.boundary_loops()]
-                    widths = [np.full(len(loop), allowance) for loop in loops]
-                    lips = drape.darted.slits.lips if drape.is_darted else []
-                net, trim = _outlines(loops, widths, allowance)
-                if lips:
-                    notches = [(coordinates[a], coordinates[b]) for a, b in lips]
-                    trim = _open_notches(net, trim, notches, allowance, dart_overlap)
-                outlines[key] = net, trim, laps if overlap > 0 else []
-            net, trim, laps = outlines[key]
+            net, trim, laps = outlines[key][index]
             target = drape.seed if index == holder else mesh.points.mean(axis=0)
             node = int(np.argmin(np.linalg.norm(mesh.points - target, axis=1)))
             fibres = pattern.fibres
@@ -182,6 +173,54 @@ def ply_blanks(result: LaminateResult) -> list[PlyBlank]:
                 )
             )
     return blanks
+
+
+class BlankOutline(NamedTuple):
+    """One piece's outlines in its pattern frame: ``net`` and ``trim`` rings (the largest first
+    and counter-clockwise, holes clockwise; module docs) and ``laps``, the indices of the
+    pieces it laps over at its splices."""
+
+    net: list[np.ndarray]
+    trim: list[np.ndarray]
+    laps: list[int]
+
+
+def blank_outlines(
+    pieces: Sequence[BlankPiece],
+    options: BlankOptions,
+    spliced: SplicedPly | None = None,
+    darted: DartedPattern | None = None,
+    ply: str = "",
+) -> list[BlankOutline]:
+    """The net and trim outlines of a ply's ``pieces`` as cut (module docs): along the mould's
+    edge the net grown by ``options.trim_allowance``; along the splices of ``spliced`` (the
+    ply cut into these pieces) the line as drawn, butt or lapping over the pieces before by
+    ``options.splice_overlap``; along the lips of the darts of ``darted`` (the ply cut whole,
+    opened along them) butt or the left lip lapping by ``options.dart_overlap``. ``ply`` names
+    the ply in the refusal of an overlap too wide for its pieces (:class:`CuttingError`)."""
+    allowance, overlap = options.trim_allowance, options.splice_overlap
+    if spliced is not None:
+        _check_overlap(ply, "splice_overlap", overlap, pieces)
+    elif darted is not None:
+        _check_overlap(ply, "dart_overlap", options.dart_overlap, pieces)
+    outlines = []
+    for index, (_, mesh, pattern) in enumerate(pieces):
+        coordinates = pattern.material_coordinates
+        laps: list[int] = []
+        if spliced is not None:  # along a splice: the line as drawn
+            loops = spliced.outline(index)
+            across = spliced.joints(index)
+            widths = [np.where(j < 0, allowance, np.where(j < index, overlap, 0.0)) for j in across]
+            laps = sorted({int(j) for a in across for j in a[(a >= 0) & (a < index)]})
+        else:  # (a dart's lips butt or lap: the notches cut open below)
+            loops = [coordinates[loop] for loop in mesh.boundary_loops()]
+            widths = [np.full(len(loop), allowance) for loop in loops]
+        net, trim = _outlines(loops, widths, allowance)
+        if darted is not None and darted.slits.lips:
+            notches = [(coordinates[a], coordinates[b]) for a, b in darted.slits.lips]
+            trim = _open_notches(net, trim, notches, allowance, options.dart_overlap)
+        outlines.append(BlankOutline(net, trim, laps if overlap > 0 else []))
+    return outlines
 
 
 def _check_overlap(ply: str, key: str, overlap: float, pieces) -> None:

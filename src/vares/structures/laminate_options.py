@@ -1,9 +1,10 @@
 """The options of a laminate and of each of its plies, declared once (see :mod:`vares.options`):
 the ``[laminate]`` table and the ``[[ply]]`` tables of a laminate job, and the keywords of
 :func:`vares.structures.laminate.drape_laminate` and :class:`vares.structures.laminate.Ply`.
-The darts and the locking angle are those of a single ply's drape
+The darts, the locking angle and the blank's allowances are those of a single ply's drape
 (:class:`~vares.analysis.dart_options.DartOptions`,
-:class:`~vares.analysis.drape_options.DrapeOptions`), taken over with
+:class:`~vares.analysis.drape_options.DrapeOptions`,
+:class:`~vares.structures.blank_options.BlankOptions`), taken over with
 :func:`vares.options.reused`."""
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from ..analysis.dart_options import DartOptions
 from ..analysis.drape_options import DrapeOptions
 from ..materials.forming import FABRIC_KINDS
 from ..options import Options, OptionsError, option, reused
+from .blank_options import BlankOptions
 
 __all__ = ["LaminateOptions", "PlyOptions"]
 
@@ -123,31 +125,28 @@ class LaminateOptions(Options):
         section="laminate",
         positive=True,
     )
-    trim_allowance: float = option(
-        0.0,
-        "float",
-        "Excess round each ply's net boundary, mesh length units: the extended (trim) boundary "
-        "of the cutter files and the outline nested on the roll.",
+    trim_allowance: float = reused(
+        BlankOptions,
+        "trim_allowance",
         section="laminate",
-        minimum=0.0,
+        help="Excess round each ply's net boundary along the mould's edge, mesh length units: "
+        "the extended (trim) boundary of the cutter files and the outline nested on the roll.",
     )
-    splice_overlap: float = option(
-        0.0,
-        "float",
-        "Overlap at the splices of every ply that names none, mesh length units: each piece "
-        "after the first laps over the pieces before it by this much (its edge along those "
-        "splices moved out); 0: butt splices, every piece cut to the splice line.",
+    splice_overlap: float = reused(
+        BlankOptions,
+        "splice_overlap",
         section="laminate",
-        minimum=0.0,
+        help="Overlap at the splices of every ply that names none, mesh length units: each "
+        "piece after the first laps over the pieces before it by this much (its edge along "
+        "those splices moved out); 0: butt splices, every piece cut to the splice line.",
     )
-    dart_overlap: float = option(
-        0.0,
-        "float",
-        "Overlap at the darts of every ply that names none, mesh length units: a dart's left "
-        "lip (as the dart runs in from its mouth) laps over the right one by this much when it "
-        "closes; 0: the lips butt, both cut to the dart line.",
+    dart_overlap: float = reused(
+        BlankOptions,
+        "dart_overlap",
         section="laminate",
-        minimum=0.0,
+        help="Overlap at the darts of every ply that names none, mesh length units: a dart's "
+        "left lip (as the dart runs in from its mouth) laps over the right one by this much "
+        "when it closes; 0: the lips butt, both cut to the dart line.",
     )
     roll_width: float | None = option(
         None,
@@ -276,21 +275,21 @@ class PlyOptions(Options):
         "across it to the boundary; the ply is cut into pieces along them, each draped, cut and "
         "nested on its own (where darts cannot relieve the shear: negatively curved moulds).",
     )
-    splice_overlap: float | None = option(
-        None,
-        "float",
-        "Overlap at the ply's splices, mesh length units: each piece after the first laps over "
-        "the pieces before it by this much; 0: butt splices (default: the laminate's).",
+    splice_overlap: float | None = reused(
+        BlankOptions,
+        "splice_overlap",
         section="ply",
-        minimum=0.0,
+        default=None,
+        help="Overlap at the ply's splices, mesh length units: each piece after the first laps "
+        "over the pieces before it by this much; 0: butt splices (default: the laminate's).",
     )
-    dart_overlap: float | None = option(
-        None,
-        "float",
-        "Overlap at the ply's darts, mesh length units: the left lip laps over the right one by "
-        "this much; 0: the lips butt (default: the laminate's).",
+    dart_overlap: float | None = reused(
+        BlankOptions,
+        "dart_overlap",
         section="ply",
-        minimum=0.0,
+        default=None,
+        help="Overlap at the ply's darts, mesh length units: the left lip laps over the right one "
+        "by this much; 0: the lips butt (default: the laminate's).",
     )
     locking_angle: float | None = reused(
         DrapeOptions,

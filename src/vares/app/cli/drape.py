@@ -14,6 +14,7 @@ import typer
 
 from ...analysis.dart_options import DartOptions
 from ...analysis.drape_options import DrapeOptions
+from ...structures.blank_options import BlankOptions
 from ...units import METRES
 from ..sections import MaterialOptions
 from .common import console, guarded, net_line, producibility_table
@@ -110,6 +111,7 @@ EXAMPLE_FLAG = example_flag(
     EXAMPLE_FLAG,
     flags(DrapeOptions),
     flags(DartOptions),
+    flags(BlankOptions),
     flags(MaterialOptions),
     OUTPUT_FLAGS,
     RUN_FLAGS[1:],
@@ -133,7 +135,9 @@ def drape(
     --splice-lines the ply is cut into pieces along the lines and each piece's pattern is
     solved: drape.json gets the splices, and splices.vtu (the mould cut into pieces) and
     pieces.dxf (every piece's pattern) and splices.png (the shear of the whole ply and of the
-    pieces, the flat pieces) are written.
+    pieces, the flat pieces) are written. In the DXF files the SEAM layer is the net boundary
+    and the CUT layer the blank as cut: the net grown by --trim-allowance along the mould's
+    edge, butt or lapping by --splice-overlap / --dart-overlap at the joints.
     """
 
     def body() -> None:
@@ -161,6 +165,7 @@ def drape(
             )
         darting = build(DartOptions, values)
         material = _material(values, darting)
+        edges = _edges(values, darting)
         units = values["units"] or (example.units if example is not None else "mm")
         if units not in METRES:
             raise InputError(f"--units must be one of {', '.join(METRES)}; got {units!r}")
@@ -204,18 +209,21 @@ def drape(
         darted, spliced = _solve_cuts(
             mesh, material, values["thickness"], options, darting, ply, polylines, splice_lines
         )
+        outlines = _outlines(darted, spliced, edges, label)  # an overlap too wide: refused here
         if darted is not None:
             data["darts"] = darted.summary()
         if spliced is not None:
             data["splices"] = spliced.summary()
+        if outlines is not None:
+            data["blank"] = _blank_summary(edges, outlines, spliced)
         folder.start()
         try:
             write_surface(folder.staged(paths[1]), mesh, None, fields, point_data)
             write_json(folder.staged(paths[0]), data)
             if darted is not None:
-                _write_darts(folder, dart_paths, darted, units, label)
+                _write_darts(folder, dart_paths, darted, units, label, outlines, edges)
             if spliced is not None:
-                _write_splices(folder, splice_paths, spliced, units, label)
+                _write_splices(folder, splice_paths, spliced, units, label, outlines, edges)
             if values["report"]:
                 from ..drape_report import drape_page
 
@@ -261,6 +269,23 @@ def _solve_cuts(mesh, material, thickness, options, darting, ply, polylines, spl
     return None, None
 
 
+def _edges(values: dict[str, Any], darting: DartOptions) -> BlankOptions:
+    """The blank's allowances; each refused where there is no joint or cutter file for it."""
+    edges = build(BlankOptions, values)
+    given = [n for n, d in BlankOptions.defaults().items() if getattr(edges, n) != d]
+    needs = {
+        "trim_allowance": (darting.needs_fabric, "the cutter files of darts or splices: add "
+                           "--darts auto, --dart-lines or --splice-lines"),
+        "splice_overlap": (darting.splice_lines is not None, "splices: add --splice-lines"),
+        "dart_overlap": (darting.wanted, "darts: add --darts auto or --dart-lines"),
+    }  # fmt: skip
+    for name in given:
+        wanted, what = needs[name]
+        if not wanted:
+            raise InputError(f"--{name.replace('_', '-')} is for {what}")
+    return edges
+
+
 def _material(values: dict[str, Any], darting: DartOptions):
     """The ply's fabric for the solves with darts (None without darts); material flags without
     darts are refused."""
@@ -286,10 +311,63 @@ def _material(values: dict[str, Any], darting: DartOptions):
     return material
 
 
-def _write_darts(folder, paths: list[Path], darted, units: str, name: str) -> None:
+def _cut_pieces(darted, spliced):
+    """The ply as cut (:class:`~vares.structures.laminate_plies.BlankPiece` each): the pieces
+    along its splices, or its one blank, opened along its darts where they are kept."""
+    from ...structures.laminate_plies import BlankPiece
+
+    if spliced is not None:
+        return [
+            BlankPiece(piece.name, piece.mesh, result)
+            for piece, result in zip(spliced.pieces, spliced.results, strict=True)
+        ]
+    cut = darted.after if darted.kept else darted.before
+    return [BlankPiece(None, cut.mesh, cut)]
+
+
+def _outlines(darted, spliced, edges: BlankOptions, name: str):
+    """Each cut piece's net and trim outlines
+    (:func:`~vares.structures.laminate_blanks.blank_outlines`), None without darts or splices;
+    an overlap as wide as half a piece is refused (exit 2) before anything is written."""
+    if darted is None and spliced is None:
+        return None
+    from ...structures.laminate_blanks import blank_outlines
+
+    kept = darted if darted is not None and darted.kept else None
+    return blank_outlines(_cut_pieces(darted, spliced), edges, spliced, kept, name)
+
+
+def _blank_summary(edges: BlankOptions, outlines, spliced) -> dict[str, Any]:
+    """drape.json's ``blank``: the allowances and each cut piece's net and trim areas."""
+    from ...structures.laminate_blanks import ring_area
+
+    def area(rings):
+        return float(sum(ring_area(r) for r in rings))
+
+    names = [None] if spliced is None else [p.name for p in spliced.pieces]
+    return {
+        **edges.to_dict(),
+        "pieces": [
+            {"piece": name, "net_area": area(o.net), "trim_area": area(o.trim)}
+            for name, o in zip(names, outlines, strict=True)
+        ],
+    }
+
+
+def _edge_lines(edges: BlankOptions, units: str, joints: str = "") -> list[str]:
+    """The cutter label's line on the blank's edges: the trim allowance, and how its
+    ``joints`` (``"splices"``, ``"darts"`` or none) are cut."""
+    line = f"trim +{edges.trim_allowance:g} {units}"
+    if joints:
+        overlap = edges.splice_overlap if joints == "splices" else edges.dart_overlap
+        line += f", {joints} lap {overlap:g} {units}" if overlap else f", {joints} butt"
+    return [line]
+
+
+def _write_darts(folder, paths: list[Path], darted, units: str, name: str, outlines, edges):
     """darts.vtu (the mould opened along the darts, the shear with them open), pattern.dxf (the
-    pattern to cut: with its darts where they are kept, else the pattern without them) and
-    darts.png."""
+    pattern to cut: with its darts where they are kept, else the pattern without them; SEAM its
+    net boundary, CUT its trim line from ``outlines``) and darts.png."""
     import matplotlib.pyplot as plt
 
     from ...io.dart_plots import plot_darts
@@ -311,15 +389,28 @@ def _write_darts(folder, paths: list[Path], darted, units: str, name: str) -> No
             f"no darts, largest shear {largest:.1f}°",
             f"darts tried, not kept: {summary['max_shear_after']:.1f}° with them",
         ]
+    label += _edge_lines(edges, units, "darts" if darted.kept else "")
     lines = darted.dart_pattern_lines() if darted.kept else []
-    piece = CutPiece(name, cut.mesh, cut.material_coordinates, cut.fibres.warp, label, darts=lines)
+    (outline,) = outlines
+    piece = CutPiece(
+        name,
+        cut.mesh,
+        cut.material_coordinates,
+        cut.fibres.warp,
+        label,
+        darts=lines,
+        seams=outline.net,
+        cut=outline.trim,
+    )
     write_dxf(folder.staged(paths[1]), [piece], units=units, model_units=units)
     figure = plot_darts(darted)
     figure.savefig(folder.staged(paths[2]))
     plt.close(figure)
 
 
-def _write_splices(folder, paths: list[Path], spliced, units: str, name: str) -> None:
+def _write_splices(folder, paths: list[Path], spliced, units: str, name: str, outlines, edges):
+    """splices.vtu, pieces.dxf (each piece: SEAM its net boundary, along a splice the line as
+    drawn; CUT its trim line from ``outlines``) and splices.png."""
     import matplotlib.pyplot as plt
 
     from ...io.dart_plots import plot_splices
@@ -333,13 +424,24 @@ def _write_splices(folder, paths: list[Path], spliced, units: str, name: str) ->
     }
     write_surface(folder.staged(paths[0]), cut.mesh, None, fields)
     pieces = []
-    for index, (piece, result) in enumerate(zip(spliced.pieces, spliced.results, strict=True)):
+    names = [p.name for p in spliced.pieces]
+    for piece, result, outline in zip(spliced.pieces, spliced.results, outlines, strict=True):
         largest = float(np.nanmax(np.abs(result.fields["shear_angle"])))
         label = [f"{name} {piece.name}", f"largest shear {largest:.1f}°"]
+        label += _edge_lines(edges, units, "splices")
+        if outline.laps:
+            label.append("laps over " + ", ".join(names[j] for j in outline.laps))
         warp = None if result.fibres is None else result.fibres.warp
-        seams = spliced.outline(index)  # along a splice, the drawn line
         pieces.append(
-            CutPiece(piece.name, result.mesh, result.material_coordinates, warp, label, seams=seams)
+            CutPiece(
+                piece.name,
+                result.mesh,
+                result.material_coordinates,
+                warp,
+                label,
+                seams=outline.net,
+                cut=outline.trim,
+            )
         )
     write_dxf(folder.staged(paths[1]), pieces, units=units, model_units=units)
     figure = plot_splices(spliced)
