@@ -353,7 +353,7 @@ def mirrored(cell_size: float, laws: list[str], locking: float, tips: list[float
     """Symmetric darts on the double dome: the first automatic dart of the plain ``ncf``
     pattern at each tip angle, mirrored across x = 0 and y = 0 (module docs)."""
     from vares import solve
-    from vares.analysis.darts import erected_yarns, place_darts
+    from vares.analysis.dart_lines import erected_yarns, place_darts
 
     mesh, warp = mould("double-dome", 0, cell_size)
     plain = solve(mesh, LAWS["ncf"](), warp_direction=warp)

@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from conftest import error_line, run
 
-from vares.analysis.darts import (
+from vares.analysis.dart_lines import (
     darts_from_polylines,
     erected_yarns,
     fall_line_darts,
     place_darts,
     smoothed,
-    solve_with_darts,
 )
+from vares.analysis.darts import solve_with_darts
 from vares.geometry.cutting import cut_mesh
 from vares.geometry.examples import grid_cells, irregular_cap
 from vares.geometry.mesh import SurfaceMesh
@@ -480,7 +480,7 @@ def test_a_nearly_closed_mould_has_no_fall_lines(monkeypatch):
     """A sphere less one triangle has no draw direction (its area vectors add up to 0.05 % of
     its area): no fall-line dart, where the same sheared region on the open hemisphere gets one
     (and the sphere gets one too when the draw direction is not asked for)."""
-    import vares.analysis.darts as darts
+    import vares.analysis.dart_lines as dart_lines
     from vares.geometry.hard_surfaces import spherical_cap
 
     cap = spherical_cap(R, 90.0, 12)
@@ -504,5 +504,5 @@ def test_a_nearly_closed_mould_has_no_fall_lines(monkeypatch):
     (line,) = fall_line_darts(cap, shear_of(cap), LOCKING, 0.8 * LOCKING)
     assert abs(line.points[0, 2]) < 1e-9  # its mouth on the equator
     assert fall_line_darts(sphere, shear_of(sphere), LOCKING, 0.8 * LOCKING) == []
-    monkeypatch.setattr(darts, "DRAWN", 0.0)
+    monkeypatch.setattr(dart_lines, "DRAWN", 0.0)
     assert len(fall_line_darts(sphere, shear_of(sphere), LOCKING, 0.8 * LOCKING)) == 1

@@ -11,7 +11,7 @@ import pytest
 from conftest import run
 from test_laminate_cutting import chromium
 
-from vares.analysis.darts import erected_yarns
+from vares.analysis.dart_lines import erected_yarns
 from vares.app.job import JobError
 from vares.app.laminate_job import LaminateJob, load_laminate_job
 from vares.app.laminate_outputs import orientation_tables

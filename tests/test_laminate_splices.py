@@ -13,7 +13,7 @@ from conftest import run
 from test_laminate_cutting import chromium
 from test_laminate_darts import JOB, parse
 
-from vares.analysis.darts import erected_yarns
+from vares.analysis.dart_lines import erected_yarns
 from vares.app.job import JobError
 from vares.app.laminate_outputs import orientation_tables
 from vares.app.ply_book import ply_book

@@ -348,7 +348,7 @@ def test_drape_command_with_splice_lines(tmp_path):
 def test_the_nearest_segment_of_a_line_with_a_repeated_point():
     """A drawn line may repeat a point (a CAD polyline's doubled vertex): its segment of zero
     length is its point, not a NaN that the search for the nearest would pick."""
-    from vares.analysis.darts import to_segments
+    from vares.analysis.dart_lines import to_segments
 
     line = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
     distance, index, t = to_segments(np.array([1.5, 0.5, 0.0]), line[:-1], line[1:])

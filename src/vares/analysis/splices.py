@@ -33,7 +33,7 @@ from ..materials import Hyperelastic
 from ..solver.api import solve
 from ..solver.result import PatternResult
 from ..structures.panels import Panel, split_panels
-from .darts import smoothed, to_segments
+from .dart_lines import smoothed, to_segments
 
 if TYPE_CHECKING:
     from .drape import PlyDrape
@@ -58,7 +58,7 @@ SPLICE_SNAP = 0.4
 def yarn_strain(result: PatternResult, nodal_mean: bool = False) -> np.ndarray | None:
     """Per cell of a pattern's mesh ``(m,)``: the larger of ``|warp stretch − 1|`` and ``|fill
     stretch − 1|`` on the mould (None for a law without yarns); with ``nodal_mean`` of the
-    stretches averaged to the nodes and back (:func:`vares.analysis.darts.smoothed`), which
+    stretches averaged to the nodes and back (:func:`vares.analysis.dart_lines.smoothed`), which
     leaves out the cell-to-cell scatter of linear triangles with stiff yarns."""
     fields = result.fields
     if "warp_stretch" not in fields:

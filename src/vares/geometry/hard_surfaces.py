@@ -139,7 +139,7 @@ def square_cup(
     a grid of ``cells`` × ``cells`` moved at random within the square by up to ``jitter`` cells
     (reproducible by ``seed``; those on the edge stay), triangulated by Delaunay in the plane.
     Draped with the yarns along x and y, its corners shear most at their concave foot, inside
-    the ply (:func:`vares.analysis.darts.fall_line_darts`)."""
+    the ply (:func:`vares.analysis.dart_lines.fall_line_darts`)."""
     from scipy.spatial import Delaunay
 
     if not 0 < top < foot < half_width:
