@@ -14,7 +14,7 @@ from scipy.spatial import Delaunay
 from vares.analysis.darts import over_locking_curvature
 from vares.analysis.splices import SPLICE_SNAP, solve_with_splices, yarn_strain
 from vares.geometry.curvature import FLAT, angle_defects, cell_gauss_curvature
-from vares.geometry.double_dome import axis_splice, double_dome
+from vares.geometry.double_dome import axis_splice, double_dome, double_dome_height
 from vares.geometry.examples import irregular_cap
 from vares.geometry.mesh import SurfaceMesh
 from vares.geometry.outline import ring_area
@@ -355,3 +355,85 @@ def test_the_nearest_segment_of_a_line_with_a_repeated_point():
     assert (distance, index, t) == (pytest.approx(0.5), 2, pytest.approx(0.5))
     distance, index, t = to_segments(np.array([1.0, 2.0, 0.0]), line[1:2], line[2:3])
     assert np.isfinite(t) and distance == pytest.approx(2.0)
+
+
+def test_splices_placed_through_the_seed(spliced):
+    """``place_splices``: on the double dome from the saddle's centre the splice along the warp
+    (the long axis) relieves the ply, as the designer's line along it does (to 0.5°); the fill's
+    is tried beside it, the diagonals are not. A 45° ply is relieved along a diagonal of its
+    yarns (the mould's long axis again) once neither yarn's splice does. A ply below the locking
+    angle gets none."""
+    from vares.analysis.splice_lines import place_splices
+
+    seed = (0.0, 0.0, float(double_dome_height(np.zeros(1), np.zeros(1))[0]))
+    mould = double_dome()
+    placed = place_splices(mould, NCF, locking_angle=LOCKING, seed=seed, warp_direction=(1, 0, 0))
+    assert [t.angles for t in placed.trials] == [(0.0,), (90.0,)]
+    assert placed.angles == (0.0,) and placed.spliced.relieved
+    assert placed.spliced.max_shear_after == pytest.approx(spliced[1].max_shear_after, abs=0.5)
+    (line,) = placed.spliced.polylines
+    # the plane y = const through the seed's point on the mould (the faceted surface's, 0.06 mm
+    # from the smooth dome's), the draw direction z and the warp x in it
+    assert np.ptp(line[:, 1]) < 1e-9 and abs(line[0, 1]) < 0.1 and np.ptp(line[:, 0]) > 300.0
+    assert placed.trials[1].max_shear > placed.trials[0].max_shear
+    turned = place_splices(mould, NCF, locking_angle=LOCKING, seed=seed, warp_direction=(1, 1, 0))
+    assert [t.angles for t in turned.trials][:4] == [(0.0,), (90.0,), (45.0,), (135.0,)]
+    assert all(t.max_shear > LOCKING for t in turned.trials[:2])
+    assert turned.angles == (135.0,) and turned.spliced.max_shear_after < 30.0
+    (line,) = turned.spliced.polylines
+    assert np.ptp(line[:, 1]) < 1e-9 and abs(line[0, 1]) < 0.1  # 135° from (1, 1, 0): along x
+    soft = place_splices(
+        irregular_cap(100.0, 90.0, 12, 0.3, 1),
+        NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [500.0]),
+        locking_angle=LOCKING,
+        seed=(0.0, 0.0, 100.0),
+        warp_direction=(1, 0, 0),
+    )
+    assert soft.spliced is None and not soft.needed and soft.summary()["angles"] is None
+
+
+def test_drape_command_places_splices(tmp_path):
+    """``vares drape --splices auto``: the lines tried and the one taken on the console and in
+    drape.json, the pieces' files; refused beside darts or drawn splice lines, or without a
+    fabric; a ply that needs no splice gets none and no pieces' files."""
+    fabric = ["--material", "ncf", "--A=-250,250", "--B=-250,250", "--C", "0.5"]
+    out = tmp_path / "out"
+    result = run(
+        "drape", "--example", "double-dome", "--splices", "auto", *fabric, "-o", out, "--report"
+    )
+    assert result.exit_code == 0, result.stderr
+    assert "taken: 0°" in result.stderr and "taken: 0°" in (out / "drape.html").read_text()
+    data = json.loads((out / "drape.json").read_text())["splices"]
+    assert data["placed"]["angles"] == [0.0] and data["relieved"] and len(data["pieces"]) == 2
+    assert (out / "pieces.dxf").exists() and (out / "splices.vtu").exists()
+    for extra, message in [
+        (["--darts", "auto", *fabric], "not both"),
+        (["--splice-lines", tmp_path / "none.txt", *fabric], "not both"),
+        ([], "splices need the ply's fabric"),
+    ]:
+        refused = run(
+            "drape", "--example", "double-dome", "--splices", "auto", *extra, "-o", tmp_path / "r"
+        )
+        assert refused.exit_code == 2 and message in error_line(refused), refused.stderr
+        assert not (tmp_path / "r").exists()
+    soft = [
+        "--material",
+        "orthotropic",
+        "--E1",
+        "1000",
+        "--E2",
+        "1000",
+        "--G12",
+        "500",
+        "--nu12",
+        "0.3",
+    ]
+    calm = run("drape", "--example", "hemisphere", "--splices", "auto", *soft, "-o", tmp_path / "c")
+    assert calm.exit_code == 0, calm.stderr
+    assert "no splice needed" in calm.stderr
+    assert not (tmp_path / "c" / "pieces.dxf").exists()
+    assert json.loads((tmp_path / "c" / "drape.json").read_text())["splices"]["placed"] == {
+        "needed": False,
+        "trials": [],
+        "angles": None,
+    }

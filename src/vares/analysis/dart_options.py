@@ -1,6 +1,6 @@
 """The options of a ply's darts and splices, declared once (see :mod:`vares.options`): the flags
-of ``vares drape`` (``--darts auto``, ``--dart-lines FILE``, ``--splice-lines FILE``) and the
-keywords of :func:`vares.analysis.darts.solve_with_darts`."""
+of ``vares drape`` (``--darts auto``, ``--dart-lines FILE``, ``--splice-lines FILE``,
+``--splices auto``) and the keywords of :func:`vares.analysis.darts.solve_with_darts`."""
 
 from __future__ import annotations
 
@@ -41,6 +41,15 @@ class DartOptions(Options):
         "(for shear darts cannot relieve: where the mould is negatively curved).",
         section="drape",
     )
+    splices: str = option(
+        "none",
+        "str",
+        "Splices where the ply's shear reaches the locking angle: 'auto' cuts it through its "
+        "seed along the warp or the fill (the diagonals where neither relieves it; both axes "
+        "where one line does not) and solves the pieces.",
+        section="drape",
+        choices=("none", "auto"),
+    )
     dart_tip: float = option(
         0.8,
         "float",
@@ -80,6 +89,10 @@ class DartOptions(Options):
             raise OptionsError(None, "give --darts auto or --dart-lines, not both")
         if self.splice_lines is not None and self.wanted:
             raise OptionsError(None, "give darts or --splice-lines, not both")
+        if self.splices == "auto" and self.splice_lines is not None:
+            raise OptionsError(None, "give --splices auto or --splice-lines, not both")
+        if self.splices == "auto" and self.wanted:
+            raise OptionsError(None, "give darts or --splices auto, not both")
 
     @property
     def wanted(self) -> bool:
@@ -87,6 +100,11 @@ class DartOptions(Options):
         return self.darts == "auto" or self.dart_lines is not None
 
     @property
+    def splicing(self) -> bool:
+        """Whether the ply is spliced: along given lines or placed ones."""
+        return self.splices == "auto" or self.splice_lines is not None
+
+    @property
     def needs_fabric(self) -> bool:
         """Whether the ply's pattern is solved: for darts or for splices."""
-        return self.wanted or self.splice_lines is not None
+        return self.wanted or self.splicing

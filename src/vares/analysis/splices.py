@@ -258,14 +258,15 @@ def solve_with_splices(
     locking_angle: float,
     polylines: Sequence[np.ndarray],
     snap: float = SPLICE_SNAP,
+    before: PatternResult | None = None,
     **settings: Any,
 ) -> SplicedPly:
     """Splice the ply on ``mesh`` (the mould) along ``polylines`` (``(k, 3)`` each, on or near
     the mould, from its boundary to its boundary; e.g. a curves file's,
     :func:`vares.io.curves.read_curves`) and solve every piece (:func:`vares.solve` with
     ``material``, ``thickness`` and the keyword ``settings``, e.g. ``warp_direction``); the whole
-    ply is solved first, for comparison (module docs); ``snap``: :data:`SPLICE_SNAP`. Quads are
-    split into triangles first.
+    ply is solved first, for comparison (module docs), unless its pattern is given (``before``,
+    of the same settings); ``snap``: :data:`SPLICE_SNAP`. Quads are split into triangles first.
 
     Raises :class:`~vares.geometry.surface_lines.CuttingError` when there are no lines or they
     do not cut the mould into pieces.
@@ -280,7 +281,8 @@ def solve_with_splices(
             "the splice lines do not cut the mould into pieces: draw each from the boundary "
             "across the mould to the boundary"
         )
-    before = solve(surface, material, thickness, **settings)
+    if before is None:
+        before = solve(surface, material, thickness, **settings)
     pieces = split_panels(
         cut.mesh, cut.panel_ids, {i: f"piece-{i + 1}" for i in range(cut.num_panels)}
     )

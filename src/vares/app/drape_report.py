@@ -5,6 +5,7 @@ the mould and on the flat pattern."""
 
 from __future__ import annotations
 
+from html import escape
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -166,11 +167,13 @@ def darts_section(darted: DartedPattern, units: str) -> list[str]:
     return parts
 
 
-def splices_section(spliced: SplicedPly, units: str) -> list[str]:
+def splices_section(spliced: SplicedPly, units: str, placed: str | None = None) -> list[str]:
     """The HTML parts on a spliced ply: the largest shear of the whole ply and of every piece,
-    the pieces' yarn strains and solves, and the shear of the pieces on the mould."""
+    the pieces' yarn strains and solves, and the shear of the pieces on the mould; ``placed``:
+    how the lines were placed (``vares drape --splices auto``'s line), if they were."""
     summary = spliced.summary()
-    rows = [
+    rows = [("placed", placed)] if placed is not None else []
+    rows += [
         ("locking angle", f"{number(spliced.locking_angle, 4)}°"),
         ("largest shear of the whole ply", f"{number(summary['max_shear_before'], 4)}°"),
         ("largest shear of its pieces", f"{number(summary['max_shear_after'], 4)}°"),
@@ -239,10 +242,12 @@ def drape_page(
     units: str,
     *,
     spliced: SplicedPly | None = None,
+    placed: str | None = None,
 ) -> str:
     """The report of ``vares drape --report``: the drape and producibility of the ply on the
     mould ``name`` and, with darts, :func:`darts_section`; with splices,
-    :func:`splices_section`."""
+    :func:`splices_section`; ``placed``: how splices were placed, or that none was needed
+    (``vares drape --splices auto``)."""
     warnings = []
     if (darted is not None and not darted.relieved) or (
         spliced is not None and not spliced.relieved
@@ -262,6 +267,8 @@ def drape_page(
     if darted is not None:
         parts += darts_section(darted, units)
     if spliced is not None:
-        parts += splices_section(spliced, units)
+        parts += splices_section(spliced, units, placed)
+    elif placed is not None:
+        parts += ["<h2>Splices</h2>", f"<p>{escape(placed)}</p>"]
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -21,7 +21,14 @@ from .common import console, guarded, net_line, producibility_table
 from .flags import InputError, build, example_flag, flags, option_parameter, with_flags
 from .pattern import RUN_FLAGS
 
-__all__ = ["DRAPE_EXAMPLES", "DrapeExample", "darts_verdict", "drape", "splices_verdict"]
+__all__ = [
+    "DRAPE_EXAMPLES",
+    "DrapeExample",
+    "darts_verdict",
+    "drape",
+    "placed_verdict",
+    "splices_verdict",
+]
 
 
 @dataclass(frozen=True)
@@ -135,7 +142,9 @@ def drape(
     --splice-lines the ply is cut into pieces along the lines and each piece's pattern is
     solved: drape.json gets the splices, and splices.vtu (the mould cut into pieces) and
     pieces.dxf (every piece's pattern) and splices.png (the shear of the whole ply and of the
-    pieces, the flat pieces) are written. In the DXF files the SEAM layer is the net boundary
+    pieces, the flat pieces) are written; --splices auto places the splice itself, through the
+    seed along the warp or the fill (the diagonals, or both axes, where that does not relieve
+    the ply). In the DXF files the SEAM layer is the net boundary
     and the CUT layer the blank as cut: the net grown by --trim-allowance along the mould's
     edge, butt or lapping by --splice-overlap / --dart-overlap at the joints.
     """
@@ -186,7 +195,7 @@ def drape(
         splice_paths = [output / "splices.vtu", output / "pieces.dxf", output / "splices.png"]
         if darting.wanted:
             paths += dart_paths
-        if splice_lines is not None:
+        if darting.splicing:
             paths += splice_paths
         if values["report"]:
             paths.append(output / "drape.html")
@@ -207,7 +216,7 @@ def drape(
         }
         point_data = {"flat_u": result.material_coordinates[:, 0]}
         point_data["flat_v"] = result.material_coordinates[:, 1]
-        darted, spliced = _solve_cuts(
+        darted, spliced, placed = _solve_cuts(
             mesh, material, values["thickness"], options, darting, ply, polylines, splice_lines
         )
         outlines = cut_outlines(darted, spliced, edges, label)  # a lap too wide: refused here
@@ -215,6 +224,10 @@ def drape(
             data["darts"] = darted.summary()
         if spliced is not None:
             data["splices"] = spliced.summary()
+        if placed is not None:
+            data["splices"] = {**data.get("splices", {}), "placed": placed.summary()}
+        if darting.splicing and spliced is None:  # placed: no splice needed, or none could be cut
+            paths = [p for p in paths if p not in splice_paths]
         if outlines is not None:
             data["blank"] = blank_summary(edges, outlines, spliced)
         folder.start()
@@ -228,7 +241,8 @@ def drape(
             if values["report"]:
                 from ..drape_report import drape_page
 
-                html = drape_page(ply, darted, label, units, spliced=spliced)
+                verdict = None if placed is None else placed_verdict(placed)
+                html = drape_page(ply, darted, label, units, spliced=spliced, placed=verdict)
                 folder.staged(paths[-1]).write_text(html, encoding="utf-8")
             folder.commit()
         finally:
@@ -238,6 +252,8 @@ def drape(
             console.print(net_line(check, result.net.valid.sum(), ply.spacing))
             if darted is not None:
                 _show_darts(darted)
+            if placed is not None:
+                console.print(placed_verdict(placed))
             if spliced is not None:
                 _show_splices(spliced, units)
             for path in paths:
@@ -246,13 +262,16 @@ def drape(
             raise typer.Exit(1)
         if spliced is not None and not spliced.converged:
             raise typer.Exit(1)
+        if placed is not None and placed.needed and spliced is None:
+            raise typer.Exit(1)
 
     guarded(body)
 
 
 def _solve_cuts(mesh, material, thickness, options, darting, ply, polylines, splice_lines):
-    """The ply's pattern with its darts open (a DartedPattern), or spliced (a SplicedPly with
-    its pieces' kinematic nets); (None, None) with neither."""
+    """The ply's pattern with its darts open (a DartedPattern), or spliced along the given lines
+    or through its seed (a SplicedPly with its pieces' kinematic nets; with ``--splices auto``
+    also the PlacedSplices); None for what was not asked."""
     locking, _ = options.locking
     common = {"locking_angle": locking, "warp_direction": tuple(float(v) for v in ply.warp)}
     if darting.wanted:
@@ -261,13 +280,40 @@ def _solve_cuts(mesh, material, thickness, options, darting, ply, polylines, spl
         darted = solve_with_darts(
             mesh, material, thickness, polylines=polylines, options=darting, **common
         )
-        return darted, None
-    if splice_lines is not None:
-        from ...analysis.splices import drape_pieces, solve_with_splices
+        return darted, None, None
+    if not darting.splicing:
+        return None, None, None
+    from ...analysis.splices import drape_pieces, solve_with_splices
 
+    placed = None
+    if splice_lines is not None:
         spliced = solve_with_splices(mesh, material, thickness, polylines=splice_lines, **common)
-        return None, drape_pieces(spliced, options, ply.warp)
-    return None, None
+    else:
+        from ...analysis.splice_lines import place_splices
+
+        placed = place_splices(mesh, material, thickness, seed=ply.seed, **common)
+        spliced = placed.spliced
+    if spliced is not None:
+        spliced = drape_pieces(spliced, options, ply.warp)
+    return None, spliced, placed
+
+
+def placed_verdict(placed) -> str:
+    """The line ``vares drape --splices auto`` prints of a
+    :class:`~vares.analysis.splice_lines.PlacedSplices`: whether a splice was needed, and the
+    lines tried through the seed with the largest shear each gave."""
+    whole = float(np.nanmax(np.abs(placed.before.fields["shear_angle"])))
+    if not placed.needed:
+        return f"no splice needed: the whole ply's largest shear is {whole:.2f}°"
+    tried = ", ".join(
+        f"{'+'.join(f'{a:g}°' for a in t.angles)} "
+        + (f"{t.max_shear:.2f}°" if t.max_shear is not None else f"not cut ({t.reason})")
+        for t in placed.trials
+    )
+    if placed.angles is None:
+        return f"splices through the seed tried ({tried}): none could be cut"
+    taken = " and ".join(f"{a:g}°" for a in placed.angles)
+    return f"splices through the seed tried (from the warp: {tried}); taken: {taken}"
 
 
 def _edges(values: dict[str, Any], darting: DartOptions) -> BlankOptions:
@@ -277,7 +323,7 @@ def _edges(values: dict[str, Any], darting: DartOptions) -> BlankOptions:
     needs = {
         "trim_allowance": (darting.needs_fabric, "the cutter files of darts or splices: add "
                            "--darts auto, --dart-lines or --splice-lines"),
-        "splice_overlap": (darting.splice_lines is not None, "splices: add --splice-lines"),
+        "splice_overlap": (darting.splicing, "splices: add --splice-lines or --splices auto"),
         "dart_overlap": (darting.wanted, "darts: add --darts auto or --dart-lines"),
     }  # fmt: skip
     for name in given:
