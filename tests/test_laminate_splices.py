@@ -432,3 +432,52 @@ def test_splices_butt_by_default_and_a_later_piece_laps_by_the_overlap(spliced):
     whole = ply_blanks(spliced)[4]
     distance, _ = _offsets(whole, np.full(len(whole.net[0]), -1))
     assert np.median(distance) == pytest.approx(0.5, abs=1e-9) and whole.laps_over == ()
+
+
+def test_splices_placed_in_a_laminates_plies():
+    """``splices = "auto"``: a laminate's ply that reaches its locking angle is spliced through
+    its seed (the shipped double dome along its long axis, below 35°); a ply that says
+    ``splices = "none"`` is not; a ply's own darts or lines override the laminate's splices.
+    Both at once are refused."""
+    from vares.geometry.double_dome import double_dome
+    from vares.structures.laminate_options import LaminateOptions
+    from vares.structures.laminate_tasks import cutting_modes
+
+    ncf = NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [0.5])
+    laminate = drape_laminate(
+        double_dome(),
+        [Ply(PlyOptions(name="A"), ncf), Ply(PlyOptions(name="B", splices="none"), ncf)],
+        splices="auto",
+        workers=1,
+        kinematic=False,
+    )
+    a, b = laminate.drape("A"), laminate.drape("B")
+    assert a.is_spliced and [p.piece for p in a.pieces] == ["piece-1", "piece-2"]
+    assert a.spliced.relieved and a.spliced.max_shear_after < 35.0
+    (line,) = a.spliced.polylines
+    # along the warp, through the seed: the warp at the seed is the reference x on the facet
+    # there, within a degree of x in plan
+    assert np.ptp(line[:, 0]) > 300.0 and np.ptp(line[:, 1]) < 0.02 * np.ptp(line[:, 0])
+    assert not b.is_spliced and np.nanmax(np.abs(b.shear_angle)) > 50.0
+    blanks = ply_blanks(laminate)
+    assert [(k.name, k.piece) for k in blanks] == [("A", "piece-1"), ("A", "piece-2"), ("B", None)]
+    spliced, darted, plain = LaminateOptions(splices="auto"), LaminateOptions(darts="auto"), None
+    cases = [
+        (PlyOptions(name="P"), spliced, ("none", "auto")),
+        (PlyOptions(name="P", darts="auto"), spliced, ("auto", "none")),
+        (PlyOptions(name="P", darts="none"), spliced, ("none", "auto")),
+        (PlyOptions(name="P", splices="none"), spliced, ("none", "none")),
+        (PlyOptions(name="P", splices="auto"), darted, ("none", "auto")),
+        (PlyOptions(name="P"), darted, ("auto", "none")),
+        (PlyOptions(name="P"), plain or LaminateOptions(), ("none", "none")),
+    ]
+    for options, table, modes in cases:
+        assert cutting_modes(Ply(options, ncf), table) == modes, (options, table)
+    lines = Ply(PlyOptions(name="P"), ncf, splice_lines=SPLICES)
+    assert cutting_modes(lines, darted) == ("none", "lines")
+    with pytest.raises(OptionsError, match="darts = 'auto' or splices = 'auto'"):
+        LaminateOptions(darts="auto", splices="auto")
+    with pytest.raises(OptionsError, match="splices = 'auto', darts or splice_lines"):
+        PlyOptions(name="P", splices="auto", darts="auto")
+    with pytest.raises(OptionsError, match="splices = 'auto', darts or splice_lines"):
+        PlyOptions(name="P", splices="auto", splice_lines="s.txt")

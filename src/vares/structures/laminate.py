@@ -254,6 +254,7 @@ def drape_laminate(
             "normal": normal,
             "task": {
                 "name": o.name,
+                "seed": tuple(seed),
                 "mesh": sub,
                 "material": ply.material,
                 "warp": warp,

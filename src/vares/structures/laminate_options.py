@@ -102,6 +102,14 @@ class LaminateOptions(Options):
         help="Darts in every ply that names none: 'auto' places them where a ply's shear reaches "
         "its locking angle and solves the ply again with them open (docs/composites.md, Darts).",
     )
+    splices: str = reused(
+        DartOptions,
+        "splices",
+        section="laminate",
+        help="Splices in every ply that names no darts or splices of its own: 'auto' cuts a ply "
+        "through its seed where its shear reaches its locking angle, along the warp or the "
+        "fill (docs/composites.md, Splices placed through the seed).",
+    )
     locking_angle: float | None = reused(
         DrapeOptions,
         "locking_angle",
@@ -173,6 +181,8 @@ class LaminateOptions(Options):
             raise OptionsError(
                 "locking_angle", f"must be at most 90 degrees; got {self.locking_angle}"
             )
+        if self.darts == "auto" and self.splices == "auto":
+            raise OptionsError(None, "give the laminate darts = 'auto' or splices = 'auto'")
 
 
 @dataclass(frozen=True)
@@ -260,6 +270,14 @@ class PlyOptions(Options):
         default=None,
         help="Darts in this ply: 'auto' or 'none' (default: the laminate's).",
     )
+    splices: str | None = reused(
+        DartOptions,
+        "splices",
+        section="ply",
+        default=None,
+        help="Splices in this ply: 'auto' (through its seed where it reaches its locking angle) "
+        "or 'none' (default: the laminate's).",
+    )
     dart_lines: str | None = reused(
         DartOptions,
         "dart_lines",
@@ -310,6 +328,10 @@ class PlyOptions(Options):
             raise OptionsError(None, "give a ply darts = 'auto' or dart_lines, not both")
         if self.splice_lines is not None and (self.darts == "auto" or self.dart_lines is not None):
             raise OptionsError(None, "give a ply darts or splice_lines, not both")
+        if self.splices == "auto" and (
+            self.darts == "auto" or self.dart_lines is not None or self.splice_lines is not None
+        ):
+            raise OptionsError(None, "give a ply splices = 'auto', darts or splice_lines")
         if self.locking_angle is not None and self.locking_angle > 90.0:
             raise OptionsError(
                 "locking_angle", f"must be at most 90 degrees; got {self.locking_angle}"

@@ -38,7 +38,9 @@ class Ply:
 
     def __post_init__(self) -> None:
         if self.splice_lines is not None and (
-            self.dart_lines is not None or self.options.darts == "auto"
+            self.dart_lines is not None
+            or self.options.darts == "auto"
+            or self.options.splices == "auto"
         ):
             raise OptionsError(None, f"ply {self.name}: give darts or splice lines, not both")
 

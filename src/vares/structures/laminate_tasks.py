@@ -34,6 +34,7 @@ import numpy as np
 
 from ..analysis.darts import solve_with_darts
 from ..analysis.drape import drape_ply
+from ..analysis.splice_lines import place_splices
 from ..analysis.splices import solve_with_splices
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.surface_lines import CuttingError
@@ -74,13 +75,24 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
     settings = {**task["solve"], "warp_direction": tuple(task["warp"])}
     darted = spliced = None
     try:
-        if task.get("splices") is not None:
+        splices = task.get("splices")
+        if splices is not None and splices["polylines"] is None:  # through the seed
+            placed = place_splices(
+                mesh,
+                task["material"],
+                1.0,
+                locking_angle=splices["locking_angle"],
+                seed=task["seed"],
+                **settings,
+            )
+            pattern, spliced = placed.before, placed.spliced
+        elif splices is not None:
             spliced = solve_with_splices(
                 mesh,
                 task["material"],
                 1.0,
-                locking_angle=task["splices"]["locking_angle"],
-                polylines=task["splices"]["polylines"],
+                locking_angle=splices["locking_angle"],
+                polylines=splices["polylines"],
                 **settings,
             )
             pattern = spliced.before
@@ -174,29 +186,43 @@ def cut_origin(mesh: SurfaceMesh, cut: SurfaceMesh) -> np.ndarray:
     return FaceLocator(mesh).locate(centroids)[0]
 
 
+def cutting_modes(ply: Ply, options: LaminateOptions) -> tuple[str, str]:
+    """How the ply is cut: its darts' mode (``"lines"``, ``"auto"`` or ``"none"``) and its
+    splices' (the same). A ply's own darts, dart lines, splice lines or splices override the
+    laminate's darts and splices; the laminate's apply to the plies that name neither."""
+    o = ply.options
+    if ply.splice_lines is not None or o.splice_lines is not None:
+        return "none", "lines"
+    if ply.dart_lines is not None or o.dart_lines is not None:
+        return "lines", "none"
+    if o.darts == "auto" or o.splices == "auto":
+        return o.darts or "none", o.splices or "none"
+    darts = o.darts or options.darts
+    splices = o.splices or ("none" if darts == "auto" else options.splices)
+    return darts, splices
+
+
 def splice_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str, Any] | None:
-    """What the ply's splices need in its task, or ``None`` without splice lines."""
-    if ply.splice_lines is None:
-        if ply.options.splice_lines is not None:
-            raise OptionsError(
-                "splice_lines", f"ply {ply.name}: pass the file's lines as splice_lines"
-            )
+    """What the ply's splices need in its task (their locking angle, and the lines: ``None`` to
+    place them through the seed), or ``None`` without splices."""
+    _, mode = cutting_modes(ply, options)
+    if mode == "none":
         return None
+    if mode == "lines" and ply.splice_lines is None:
+        raise OptionsError("splice_lines", f"ply {ply.name}: pass the file's lines as splice_lines")
     if set(mesh.cells) != {"triangle"}:
         raise OptionsError("splice_lines", f"ply {ply.name}: splices need a mould of triangles")
-    return {
-        "locking_angle": ply_locking_angle(options, ply.options),
-        "polylines": [np.asarray(p, float) for p in ply.splice_lines],
-    }
+    lines = None if mode == "auto" else [np.asarray(p, float) for p in ply.splice_lines]
+    return {"locking_angle": ply_locking_angle(options, ply.options), "polylines": lines}
 
 
 def dart_task(ply: Ply, options: LaminateOptions, mesh: SurfaceMesh) -> dict[str, Any] | None:
     """What the ply's darts need in its task, or ``None`` without darts (a spliced ply has
     none: its pieces relieve it)."""
-    mode = ply.options.darts or options.darts
-    if ply.dart_lines is None and (mode == "none" or ply.splice_lines is not None):
+    mode, _ = cutting_modes(ply, options)
+    if mode == "none":
         return None
-    if ply.options.dart_lines is not None and ply.dart_lines is None:
+    if mode == "lines" and ply.dart_lines is None:
         raise OptionsError("dart_lines", f"ply {ply.name}: pass the file's lines as dart_lines")
     if set(mesh.cells) != {"triangle"}:
         raise OptionsError("darts", f"ply {ply.name}: darts need a mould of triangles")
