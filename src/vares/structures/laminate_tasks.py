@@ -13,10 +13,12 @@ triangle. A ply is cut with its darts only when they lower its largest shear
 (:func:`~vares.structures.laminate_plies.darts_used`): darts that leave it as high or higher
 (the rib's, docs/composites.md) are reported, and the ply is cut whole.
 
-A ply with splice lines is solved by :func:`vares.analysis.splices.solve_with_splices`: the
-pattern of the ply's mesh (the pair check's), then the mesh cut into pieces along the lines and
-every piece's pattern; with the kinematic net, every piece gets its own too (from its node
-nearest its centroid), beside the whole ply's. The cut splits the cells the lines cross, too;
+A ply with splice lines is solved by :func:`vares.analysis.splices.solve_with_splices`, one
+with ``splices = "auto"`` by :func:`vares.analysis.splice_lines.place_splices` (through its
+seed; none where it stays below its locking angle): the pattern of the ply's mesh (the pair
+check's), then the mesh cut into pieces along the lines and every piece's pattern; with the
+kinematic net, every piece gets its own too (from its node nearest its centroid), beside the
+whole ply's. The cut splits the cells the lines cross, too;
 each cut cell lies in one cell of the ply's mesh (:func:`cut_origin`).
 :func:`on_mould_cells` gives every cell of the ply's mesh the area-weighted mean of its pieces
 (unit vectors normalised again), which is the piece's own value where the cell is whole.
@@ -76,26 +78,15 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
     darted = spliced = None
     try:
         splices = task.get("splices")
-        if splices is not None and splices["polylines"] is None:  # through the seed
-            placed = place_splices(
-                mesh,
-                task["material"],
-                1.0,
-                locking_angle=splices["locking_angle"],
-                seed=task["seed"],
-                **settings,
-            )
-            pattern, spliced = placed.before, placed.spliced
-        elif splices is not None:
-            spliced = solve_with_splices(
-                mesh,
-                task["material"],
-                1.0,
-                locking_angle=splices["locking_angle"],
-                polylines=splices["polylines"],
-                **settings,
-            )
-            pattern = spliced.before
+        if splices is not None:
+            cut = {"locking_angle": splices["locking_angle"], **settings}
+            if splices["polylines"] is None:  # through the seed
+                placed = place_splices(mesh, task["material"], 1.0, seed=task["seed"], **cut)
+                pattern, spliced = placed.before, placed.spliced
+            else:
+                lines = splices["polylines"]
+                spliced = solve_with_splices(mesh, task["material"], 1.0, polylines=lines, **cut)
+                pattern = spliced.before
         elif task["darts"] is None:
             pattern = solve(mesh, task["material"], 1.0, **settings)
         else:
