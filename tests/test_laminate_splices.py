@@ -459,6 +459,9 @@ def test_splices_placed_in_a_laminates_plies():
     # there, within a degree of x in plan
     assert np.ptp(line[:, 0]) > 300.0 and np.ptp(line[:, 1]) < 0.02 * np.ptp(line[:, 0])
     assert not b.is_spliced and np.nanmax(np.abs(b.shear_angle)) > 50.0
+    placed = a.summary()["splices"]["placed"]
+    assert placed["needed"] and placed["angles"] == [0.0] and len(placed["trials"]) == 2
+    assert b.summary()["splices"] is None
     blanks = ply_blanks(laminate)
     assert [(k.name, k.piece) for k in blanks] == [("A", "piece-1"), ("A", "piece-2"), ("B", None)]
     spliced, darted, plain = LaminateOptions(splices="auto"), LaminateOptions(darts="auto"), None

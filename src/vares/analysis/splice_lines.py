@@ -17,9 +17,8 @@ part along both its axes. What was tried is kept beside the choice
 On the shipped double dome (the non-crimp fabric of the README, warp along x, the seed at the
 saddle's centre) the splice along the warp (its long axis) takes the largest shear from 57.8° to
 30.0°, across it 44.2°, along the diagonals (were they tried) 83.7° and 72.1°: the diagonals cut
-the domes' walls where they are sheared most. A splice through a point chosen otherwise, the most sheared cell (on a
-dome's wall), raised it to 58–76° (docs/composites.md).
-"""
+the domes' walls where they are sheared most. A splice through a point chosen otherwise, the
+most sheared cell (on a dome's wall), raised it to 58–76° (docs/composites.md)."""
 
 from __future__ import annotations
 

@@ -354,6 +354,7 @@ def _drape_result(mesh: SurfaceMesh, group: dict[str, Any], outcome: dict[str, A
         locking_angle=group["locking_angle"],
         darted=darted,
         spliced=spliced,
+        placed=outcome.get("placed"),
     )
 
 

@@ -76,7 +76,9 @@ class PlyDrapeResult:
     ``kinematic_error``). ``darted``: the ply with its darts open (``None`` without darts asked
     for; its ``after`` is ``None`` when none was needed or placed; the ply is cut with them when
     :attr:`is_darted`) and ``locking_angle`` (degrees). ``spliced``: the ply cut into pieces
-    along its splice lines and each piece's pattern (``None`` without splice lines).
+    along its splice lines and each piece's pattern (``None`` without splice lines), and with
+    ``splices = "auto"`` ``placed``: what was tried through its seed and taken
+    (:meth:`vares.analysis.splice_lines.PlacedSplices.summary`).
     Per mould cell ``(m,)`` / ``(m, 3)``, NaN outside the ply: ``warp``, ``fill`` (unit erected
     yarns), ``shear_angle`` (degrees, the decrease of the angle between the yarns) of the ply as
     laid (the darted or spliced patterns', each mould cell the area-weighted mean of its pieces
@@ -109,6 +111,7 @@ class PlyDrapeResult:
     locking_angle: float = float("nan")
     darted: DartedPattern | None = None
     spliced: SplicedPly | None = None
+    placed: dict[str, Any] | None = None
 
     @property
     def is_spliced(self) -> bool:
@@ -181,4 +184,6 @@ class PlyDrapeResult:
         data["locking_angle"] = self.locking_angle
         data["darts"] = None if self.darted is None else self.darted.summary()
         data["splices"] = None if self.spliced is None else self.spliced.summary()
+        if self.placed is not None:
+            data["splices"] = {**(data["splices"] or {}), "placed": self.placed}
         return data

@@ -75,14 +75,14 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
     started = time.perf_counter()
     mesh = task["mesh"]
     settings = {**task["solve"], "warp_direction": tuple(task["warp"])}
-    darted = spliced = None
+    darted = spliced = placed = None
     try:
         splices = task.get("splices")
         if splices is not None:
             cut = {"locking_angle": splices["locking_angle"], **settings}
             if splices["polylines"] is None:  # through the seed
-                placed = place_splices(mesh, task["material"], 1.0, seed=task["seed"], **cut)
-                pattern, spliced = placed.before, placed.spliced
+                found = place_splices(mesh, task["material"], 1.0, seed=task["seed"], **cut)
+                pattern, spliced, placed = found.before, found.spliced, found.summary()
             else:
                 lines = splices["polylines"]
                 spliced = solve_with_splices(mesh, task["material"], 1.0, polylines=lines, **cut)
@@ -114,6 +114,7 @@ def _drape(task: dict[str, Any]) -> dict[str, Any]:
         "pattern": pattern,
         "darted": darted,
         "spliced": spliced,
+        "placed": placed,
         "kinematic": kinematic,
         "error": error,
         "seconds": time.perf_counter() - started,
