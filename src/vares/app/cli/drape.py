@@ -144,9 +144,9 @@ def drape(
     pieces.dxf (every piece's pattern) and splices.png (the shear of the whole ply and of the
     pieces, the flat pieces) are written; --splices auto places the splice itself, through the
     seed along the warp or the fill (the diagonals, or both axes, where that does not relieve
-    the ply). In the DXF files the SEAM layer is the net boundary
-    and the CUT layer the blank as cut: the net grown by --trim-allowance along the mould's
-    edge, butt or lapping by --splice-overlap / --dart-overlap at the joints.
+    the ply). In the DXF files the SEAM layer is the net boundary and the CUT layer the blank
+    as cut: the net grown by --trim-allowance along the mould's edge, butt or lapping by
+    --splice-overlap / --dart-overlap at the joints.
     """
 
     def body() -> None:
