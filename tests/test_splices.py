@@ -361,8 +361,9 @@ def test_splices_placed_through_the_seed(spliced):
     """``place_splices``: on the double dome from the saddle's centre the splice along the warp
     (the long axis) relieves the ply, as the designer's line along it does (to 0.5°); the fill's
     is tried beside it, the diagonals are not. A 45° ply is relieved along a diagonal of its
-    yarns (the mould's long axis again) once neither yarn's splice does. A ply below the locking
-    angle gets none."""
+    yarns (the mould's long axis again) once neither yarn's splice does. A ply laid from a
+    hemisphere's rim with its warp up the wall is spliced along the meridian. A ply below the
+    locking angle gets none."""
     from vares.analysis.splice_lines import place_splices
 
     seed = (0.0, 0.0, float(double_dome_height(np.zeros(1), np.zeros(1))[0]))
@@ -382,6 +383,18 @@ def test_splices_placed_through_the_seed(spliced):
     assert turned.angles == (135.0,) and turned.spliced.max_shear_after < 30.0
     (line,) = turned.spliced.polylines
     assert np.ptp(line[:, 1]) < 1e-9 and abs(line[0, 1]) < 0.1  # 135° from (1, 1, 0): along x
+    # a ply laid from the rim with its warp up the wall (along the draw direction): the planes
+    # contain the normal at the seed, and the splice runs along the meridian over the pole
+    rim = place_splices(
+        irregular_cap(100.0, 90.0, 20, 0.3, 1),
+        NCF,
+        locking_angle=LOCKING,
+        seed=(100.0, 0.0, 0.0),
+        warp_direction=(0, 0, 1),
+    )
+    (line,) = rim.spliced.polylines
+    assert rim.angles == (0.0,) and rim.spliced.relieved
+    assert np.abs(line[:, 1]).max() < 1.0 and line[:, 2].max() > 99.0  # over the pole
     soft = place_splices(
         irregular_cap(100.0, 90.0, 12, 0.3, 1),
         NonCrimpFabric([-250.0, 250.0], [-250.0, 250.0], [500.0]),

@@ -4,7 +4,8 @@ Darts cannot relieve a negatively curved region (:mod:`vares.analysis.splices`);
 the ply through, and each piece is laid on its own. The pieces are laid from the ply's seed out,
 so the splice goes through the seed: the plane section of the mould through the seed that
 contains the mould's draw direction (the mean of its cells' normals, the direction a punch
-closes in; where it has none, the normal at the seed) and runs along the warp, the fill or one
+closes in; where it has none, or where the warp runs within :data:`STEEP_WARP` of it, the
+normal at the seed) and runs along the warp, the fill or one
 of the diagonals between them (:data:`ANGLES`, degrees from the warp about the draw direction).
 Each is solved (:func:`~vares.analysis.splices.solve_with_splices`), the two along the yarns
 first: of those that bring every piece below the locking angle the one with the least largest
@@ -28,12 +29,14 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry.face_walk import node_normals
 from ..geometry.mesh import SurfaceMesh
 from ..geometry.surface_lines import CuttingError, plane_sections, triangulated
 from ..geometry.surface_points import FaceLocator
 from ..materials import Hyperelastic
 from ..solver.api import solve
 from ..solver.result import PatternResult
+from .dart_lines import DRAWN
 from .splices import SplicedPly, solve_with_splices
 
 __all__ = ["ANGLES", "PlacedSplices", "SpliceTrial", "place_splices", "seed_splice_lines"]
@@ -41,6 +44,9 @@ __all__ = ["ANGLES", "PlacedSplices", "SpliceTrial", "place_splices", "seed_spli
 #: The directions of the splice lines tried through the seed, degrees from the warp about the
 #: draw direction: along the yarns first, then the diagonals.
 ANGLES = (0.0, 90.0, 45.0, 135.0)
+#: Where the warp at the seed runs within this many degrees of the draw direction (a ply laid
+#: from a mould's rim up its wall), the planes contain the normal at the seed instead.
+STEEP_WARP = 30.0
 
 
 @dataclass(frozen=True)
@@ -103,15 +109,16 @@ def seed_splice_lines(
     face, _, point = FaceLocator(surface).locate(np.asarray(seed, dtype=float))
     at, face = point[0], int(face[0])
     vectors = surface.area_vectors()
+    normal_at = node_normals(surface)[surface.cells["triangle"][face]].sum(axis=0)
     up = vectors.sum(axis=0)
-    if not np.linalg.norm(up) > 0.2 * np.linalg.norm(vectors, axis=1).sum():
-        up = vectors[face]  # no draw direction (a nearly closed mould): the seed's normal
+    if not np.linalg.norm(up) > DRAWN * np.linalg.norm(vectors, axis=1).sum():
+        up = normal_at  # no draw direction (a nearly closed mould): the normal at the seed
     up = up / np.linalg.norm(up)
-    warp = np.asarray(warp_direction, dtype=float)
+    warp = np.asarray(warp_direction, dtype=float) / np.linalg.norm(warp_direction)
+    if abs(warp @ up) > np.cos(np.radians(STEEP_WARP)):  # the warp runs up the draw direction
+        up = normal_at / np.linalg.norm(normal_at)
     along = warp - (warp @ up) * up
-    if not np.linalg.norm(along) > 1e-9 * np.linalg.norm(warp):
-        raise CuttingError("the warp runs along the mould's draw direction: no splice across it")
-    along /= np.linalg.norm(along)
+    along /= np.linalg.norm(along)  # (a warp along the normal at the seed is refused before)
     across = np.cross(up, along)
     edge = float(np.linalg.norm(np.diff(surface.points[surface.edges()], axis=1), axis=2).mean())
     lines: list[np.ndarray | None] = []
