@@ -462,6 +462,8 @@ def test_splices_placed_in_a_laminates_plies():
     placed = a.summary()["splices"]["placed"]
     assert placed["needed"] and placed["angles"] == [0.0] and len(placed["trials"]) == 2
     assert b.summary()["splices"] is None
+    book = ply_book(laminate, ply_blanks(laminate), None, units="mm")
+    assert "through the seed at 0° from the warp (tried 0°" in book
     blanks = ply_blanks(laminate)
     assert [(k.name, k.piece) for k in blanks] == [("A", "piece-1"), ("A", "piece-2"), ("B", None)]
     spliced, darted, plain = LaminateOptions(splices="auto"), LaminateOptions(darts="auto"), None
