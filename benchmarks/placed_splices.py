@@ -22,7 +22,7 @@ import warnings
 
 import numpy as np
 
-from vares.analysis.splice_lines import place_splices
+from vares.analysis.splice_lines import place_splices, placed_text
 from vares.geometry.double_dome import double_dome, double_dome_height
 from vares.geometry.examples import irregular_cap
 from vares.geometry.hard_surfaces import square_cup
@@ -55,16 +55,9 @@ def main() -> None:
         )
         seconds = time.perf_counter() - start
         whole = float(np.nanmax(np.abs(placed.before.fields["shear_angle"])))
-        tried = ", ".join(
-            "+".join(f"{a:g}°" for a in t.angles)
-            + (f" {t.max_shear:.2f}°" if t.max_shear is not None else f" ({t.reason})")
-            + ("" if t.converged or t.max_shear is None else " not converged")
-            for t in placed.trials
-        )
-        taken = "none" if placed.angles is None else "+".join(f"{a:g}°" for a in placed.angles)
+        how = placed_text(placed.summary())
         print(
-            f"{name} ({mesh.num_cells} cells): whole ply {whole:.2f}°; tried {tried or 'none'}; "
-            f"taken {taken}; {seconds:.1f} s",
+            f"{name} ({mesh.num_cells} cells): whole ply {whole:.2f}°; {how}; {seconds:.1f} s",
             flush=True,
         )
     print(

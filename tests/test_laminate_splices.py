@@ -466,7 +466,8 @@ def test_splices_placed_in_a_laminates_plies():
     assert "through the seed at 0° from the warp (tried 0°" in book
     blanks = ply_blanks(laminate)
     assert [(k.name, k.piece) for k in blanks] == [("A", "piece-1"), ("A", "piece-2"), ("B", None)]
-    spliced, darted, plain = LaminateOptions(splices="auto"), LaminateOptions(darts="auto"), None
+    spliced, darted = LaminateOptions(splices="auto"), LaminateOptions(darts="auto")
+    plain = LaminateOptions()
     cases = [
         (PlyOptions(name="P"), spliced, ("none", "auto")),
         (PlyOptions(name="P", darts="auto"), spliced, ("auto", "none")),
@@ -474,7 +475,7 @@ def test_splices_placed_in_a_laminates_plies():
         (PlyOptions(name="P", splices="none"), spliced, ("none", "none")),
         (PlyOptions(name="P", splices="auto"), darted, ("none", "auto")),
         (PlyOptions(name="P"), darted, ("auto", "none")),
-        (PlyOptions(name="P"), plain or LaminateOptions(), ("none", "none")),
+        (PlyOptions(name="P"), plain, ("none", "none")),
     ]
     for options, table, modes in cases:
         assert cutting_modes(Ply(options, ncf), table) == modes, (options, table)

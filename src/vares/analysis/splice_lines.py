@@ -39,7 +39,14 @@ from ..solver.result import PatternResult
 from .dart_lines import DRAWN
 from .splices import SplicedPly, solve_with_splices
 
-__all__ = ["ANGLES", "PlacedSplices", "SpliceTrial", "place_splices", "seed_splice_lines"]
+__all__ = [
+    "ANGLES",
+    "PlacedSplices",
+    "SpliceTrial",
+    "place_splices",
+    "placed_text",
+    "seed_splice_lines",
+]
 
 #: The directions of the splice lines tried through the seed, degrees from the warp about the
 #: draw direction: along the yarns first, then the diagonals.
@@ -93,6 +100,26 @@ class PlacedSplices:
             "trials": [t.summary() for t in self.trials],
             "angles": None if self.angles is None else list(self.angles),
         }
+
+
+def placed_text(placed: dict[str, Any]) -> str:
+    """How splices were placed, in words, from :meth:`PlacedSplices.summary` (as ``drape.json``
+    and ``laminate.json`` keep it): "through the seed at 0° from the warp (tried 0° 30.00°, 90°
+    44.22°)", "through the seed none could be cut (tried …)" or "no splice needed"."""
+    if not placed["needed"]:
+        return "no splice needed"
+
+    def trial(t: dict[str, Any]) -> str:
+        angles = "+".join(f"{a:g}°" for a in t["angles"])
+        if t["max_shear"] is None:
+            return f"{angles} not cut ({t['reason']})"
+        return f"{angles} {t['max_shear']:.2f}°" + ("" if t["converged"] else " not converged")
+
+    tried = ", ".join(trial(t) for t in placed["trials"])
+    if placed["angles"] is None:
+        return f"through the seed none could be cut (tried {tried})"
+    taken = "+".join(f"{a:g}°" for a in placed["angles"])
+    return f"through the seed at {taken} from the warp (tried {tried})"
 
 
 def seed_splice_lines(

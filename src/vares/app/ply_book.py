@@ -26,6 +26,7 @@ import numpy as np
 
 from ..analysis.drape_options import DrapeOptions
 from ..analysis.producibility import CLASSES, Producibility, producibility
+from ..analysis.splice_lines import placed_text
 from ..structures.laminate import LaminateResult, PlyDrapeResult
 from ..structures.laminate_blanks import PlyBlank
 from ..structures.laminate_pairs import PAIR_TITLES
@@ -255,22 +256,6 @@ def _splices_text(blank, units: str) -> str:
     )
 
 
-def _placed_text(placed: dict) -> str:
-    """How a ply's splices were placed (``splices = "auto"``): the lines tried through its seed
-    and the one taken, or that it needed none."""
-    if not placed["needed"]:
-        return "none needed: the whole ply is below its locking angle"
-    tried = ", ".join(
-        "+".join(f"{a:g}°" for a in t["angles"])
-        + (f" {number(t['max_shear'], 4)}°" if t["max_shear"] is not None else " (not cut)")
-        for t in placed["trials"]
-    )
-    if placed["angles"] is None:
-        return f"through the seed, none could be cut (tried {tried})"
-    taken = "+".join(f"{a:g}°" for a in placed["angles"])
-    return f"through the seed at {taken} from the warp (tried {tried})"
-
-
 def _ply_section(result, blank, check, units, figures: dict[tuple, list[str]]) -> list[str]:
     drape: PlyDrapeResult = result.drape(blank.name)
     ply = next(p for p in result.laminate.plies if p.name == blank.name)
@@ -288,7 +273,7 @@ def _ply_section(result, blank, check, units, figures: dict[tuple, list[str]]) -
         ("net area (flat)", f"{number(blank.net_area)} {units}²"),
         (f"blank area (trim +{blank.allowance:g} {units})", f"{number(blank.trim_area)} {units}²"),
         *([("splices", _splices_text(blank, units))] if blank.piece is not None else []),
-        *([("splices placed", _placed_text(drape.placed))] if drape.placed is not None else []),
+        *([("splices placed", placed_text(drape.placed))] if drape.placed is not None else []),
         ("mass of the net", _mass(blank, blank.net_area, units)),
         ("mass of the blank as cut", _mass(blank, blank.trim_area, units)),
         ("largest shear", f"{number(check.max_shear, 4)}°"),

@@ -301,19 +301,14 @@ def _solve_cuts(mesh, material, thickness, options, darting, ply, polylines, spl
 def placed_verdict(placed) -> str:
     """The line ``vares drape --splices auto`` prints of a
     :class:`~vares.analysis.splice_lines.PlacedSplices`: whether a splice was needed, and the
-    lines tried through the seed with the largest shear each gave."""
+    lines tried through the seed with the largest shear each gave
+    (:func:`~vares.analysis.splice_lines.placed_text`)."""
+    from ...analysis.splice_lines import placed_text
+
+    if placed.needed:
+        return f"splices placed {placed_text(placed.summary())}"
     whole = float(np.nanmax(np.abs(placed.before.fields["shear_angle"])))
-    if not placed.needed:
-        return f"no splice needed: the whole ply's largest shear is {whole:.2f}°"
-    tried = ", ".join(
-        f"{'+'.join(f'{a:g}°' for a in t.angles)} "
-        + (f"{t.max_shear:.2f}°" if t.max_shear is not None else f"not cut ({t.reason})")
-        for t in placed.trials
-    )
-    if placed.angles is None:
-        return f"splices through the seed tried ({tried}): none could be cut"
-    taken = " and ".join(f"{a:g}°" for a in placed.angles)
-    return f"splices through the seed tried (from the warp: {tried}); taken: {taken}"
+    return f"no splice needed: the whole ply's largest shear is {whole:.2f}°"
 
 
 def _edges(values: dict[str, Any], darting: DartOptions) -> BlankOptions:
@@ -322,7 +317,7 @@ def _edges(values: dict[str, Any], darting: DartOptions) -> BlankOptions:
     given = [n for n, d in BlankOptions.defaults().items() if getattr(edges, n) != d]
     needs = {
         "trim_allowance": (darting.needs_fabric, "the cutter files of darts or splices: add "
-                           "--darts auto, --dart-lines or --splice-lines"),
+                           "--darts auto, --dart-lines, --splice-lines or --splices auto"),
         "splice_overlap": (darting.splicing, "splices: add --splice-lines or --splices auto"),
         "dart_overlap": (darting.wanted, "darts: add --darts auto or --dart-lines"),
     }  # fmt: skip
