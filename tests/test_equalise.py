@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from vares.geometry.surface_lines import CuttingError
-from vares.structures.equalise import _EQUAL, _respaced, least_count
+from vares.structures.equalise import _EQUAL, _FLOOR, NotNarrowerError, _respaced, least_count
 
 
 def density_model(calls: list[int]):
@@ -70,6 +70,35 @@ def test_gaps_that_do_not_get_narrower_are_refused_early():
     with pytest.raises(CuttingError, match="do not get narrower with their number"):
         least_count(bowed, 1.0, 3, 1, 0.9, 200, True)
     assert max(calls) <= 12 and len(calls) <= 8
+
+
+def test_no_gap_is_squeezed_below_a_tenth_of_the_mean_span():
+    """A gap whose width hardly depends on its span (a strip that bows): respacing would give
+    it ever less span (the wave along y got lines 4 mm apart, and they met). Its span stops at
+    a tenth of the mean, and the search refuses the strips as bowed once it is too wide there,
+    instead of going on to more lines."""
+    spans = np.array([0.2, 0.2, 0.2, 0.2, 0.2])
+    widths = np.array([0.2, 0.2, 5.0, 0.2, 0.2])
+    for count in (5, 8):
+        new = _respaced(spans, widths, count, 1.0)
+        assert new.sum() == pytest.approx(1.0, abs=1e-14)
+        assert new.min() >= _FLOOR / count * (1 - 1e-12)
+        assert np.argmin(new) == np.argmin(np.abs(np.cumsum(new) - 0.5 - new / 2))
+    seen: list[np.ndarray] = []
+
+    def bowed(spans):  # the gap over the middle is 1.2 wide however narrow its span
+        seen.append(np.array(spans))
+        bounds = np.concatenate([[0.0], np.cumsum(spans)])
+        widths = np.array(spans, dtype=float)
+        middle = np.searchsorted(bounds, 0.5, side="right") - 1
+        widths[middle] = 1.2
+        return SimpleNamespace(widths=list(widths)), widths
+
+    with pytest.raises(NotNarrowerError, match="a tenth as wide as their mean spacing") as err:
+        least_count(bowed, 1.0, 4, 1, 0.5, 200, False)
+    assert err.value.bowed
+    assert min((s / s.mean()).min() for s in seen) >= _FLOOR * (1 - 1e-12)
+    assert max(len(s) for s in seen) <= 6 and len(seen) <= 16  # not on to 200 strips
 
 
 def test_strips_that_cannot_be_paired_are_planned_alone():

@@ -9,7 +9,9 @@ tried) or its mean gap width shows that none will (``_HOPELESS``: the gaps' widt
 about the same whatever their spans; then as many more as the mean is too wide); the next
 number starts from the last one's lines, respaced into parts of equal estimated width (from
 evenly spaced lines where the last one's gaps were as wide as each other but for the mesh's
-noise, ``_EVEN``). The
+noise, ``_EVEN``). No gap is
+given less than a tenth of the mean span (``_FLOOR``): one still too wide there bows, and the
+strips are refused as not getting narrower with their number (:func:`_bowing`). The
 number taken, the least that fits, is then equalised in full (to ``_EQUAL``, or the budget);
 if one fewer missed the roll by less than the widths' noise (``_NOISE``) with its mean gap
 within the roll, it is tried again from evenly spaced lines first, and taken if it fits.
@@ -41,6 +43,12 @@ _EVEN = 1.03
 _NOISE = 1.01
 #: Twice the gaps (or more) and still this fraction of their mean width: more will not fit.
 _NARROWER = 0.8
+#: No gap is respaced narrower than this fraction of the mean span of its number of gaps. A gap
+#: that is still too wide at that span bows (its width does not come from its span): more lines
+#: will not make it fit. Without the floor, compas-FoFin's wave along y at a 0.5 m roll got
+#: lines 4 mm apart (spans 0.025 of their mean) where its strips bow, and snapping their
+#: crossings onto the mesh's nodes joined them ("cutting lines 30 and 31 meet").
+_FLOOR = 0.1
 
 
 class NoFitError(CuttingError):
@@ -50,11 +58,11 @@ class NoFitError(CuttingError):
 
 class NotNarrowerError(NoFitError):
     """Strips that do not get narrower with their number; ``mean`` is the mean gap width of the
-    most gaps tried."""
+    most gaps tried; ``bowed`` whether a gap was too wide at the least span a gap may have."""
 
-    def __init__(self, message: str, mean: float) -> None:
+    def __init__(self, message: str, mean: float, bowed: bool = False) -> None:
         super().__init__(message)
-        self.mean = mean
+        self.mean, self.bowed = mean, bowed
 
 
 #: A layout of gaps of the given parameter spans, and the width of each gap.
@@ -70,6 +78,7 @@ class _Count:
         self.plan: StripPlan | None = None
         self.spans = self.widths = self.following = self.start = np.zeros(0)
         self.evaluations, self.equal = 0, False
+        self.bowed: tuple[float, float] | None = None  # a gap too wide at the floor: width, span
 
     @property
     def widest(self) -> float:
@@ -88,14 +97,40 @@ class _Count:
             spans = self.following
             candidate, widths = evaluate(spans)
             self.evaluations += 1
+            widest = int(np.argmax(widths))
+            if widths[widest] > width and spans[widest] <= (1 + 1e-9) * _floor(total, len(spans)):
+                self.bowed = (float(widths[widest]), float(spans[widest]))
             if self.plan is None or widths.max() < self.widest:
                 self.plan, self.spans, self.widths = candidate, spans, widths
             if widths.max() <= _EQUAL * widths.min():
                 self.equal = True
                 break
             self.following = _respaced(spans, widths, len(spans), total, damping=0.7)
-            if not polish and (self.widest <= width or widths.mean() > _HOPELESS * width):
+            if not polish and (
+                self.widest <= width or widths.mean() > _HOPELESS * width or self.bowed
+            ):
                 break
+
+
+def _floor(total: float, count: int) -> float:
+    """The least span of a gap among ``count`` over ``total`` (:data:`_FLOOR`)."""
+    return _FLOOR * total / count
+
+
+def _floored(spans: np.ndarray, total: float) -> np.ndarray:
+    """``spans`` (adding up to ``total``) with none below :func:`_floor`: the shortfall taken
+    from the others in proportion to what they have above it."""
+    spans = np.array(spans, dtype=float)
+    low = _floor(total, len(spans))
+    for _ in range(len(spans)):
+        short = spans < low
+        if not short.any():
+            break
+        need = float(np.sum(low - spans[short]))
+        spans[short] = low
+        above = np.where(short, 0.0, spans - low)
+        spans -= need * above / above.sum()
+    return spans
 
 
 def _respaced(
@@ -111,12 +146,33 @@ def _respaced(
         return np.full(count, total / count)  # equal to the noise: as wide per span everywhere
     if count == len(spans):
         scaled = spans * (widths.mean() / widths) ** damping
-        return scaled * (total / scaled.sum())
+        return _floored(scaled * (total / scaled.sum()), total)
     cumulative = np.concatenate([[0.0], np.cumsum(widths)])
     bounds = np.interp(
         np.linspace(0.0, cumulative[-1], count + 1), cumulative, np.r_[0.0, np.cumsum(spans)]
     )
-    return np.diff(bounds) * (total / bounds[-1])
+    return _floored(np.diff(bounds) * (total / bounds[-1]), total)
+
+
+def _bowing(trial: _Count, width: float, interlock: bool) -> None:
+    """Raise if a gap of ``trial`` was too wide for ``width`` at the least span a gap may have
+    (:data:`_FLOOR`): its strips bow, and more lines will not make them fit."""
+    if trial.bowed is None:
+        return
+    wide, _ = trial.bowed
+    kind = "strips in pairs" if interlock else "strips"
+    raise NotNarrowerError(
+        f"{kind} do not get narrower with their number: of {len(trial.spans)} gaps between "
+        f"cutting lines, one a tenth as wide as their mean spacing still leaves a strip "
+        f"{wide:.4g} wide (strips at most {width:g} wide): "
+        + (
+            "plan them one after the other (interlock never)"
+            if interlock
+            else "its flattened strips bow; try another strip direction or layout"
+        ),
+        float(trial.widths.mean()),
+        bowed=True,
+    )
 
 
 def _narrowing(tried: dict[int, _Count], count: int, width: float, interlock: bool) -> None:
@@ -168,6 +224,7 @@ def least_count(
         elif fits:
             break
         else:  # as many more as the mean gap is too wide (then back down, one at a time)
+            _bowing(trial, width, interlock)
             _narrowing(tried, count, width, interlock)
             following = max(count + 1, math.ceil(count * trial.widths.mean() / width))
         spans = _respaced(trial.spans, trial.widths, following, total)

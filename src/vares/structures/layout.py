@@ -157,8 +157,8 @@ def _in_pieces(evaluate, whole: NotNarrowerError, total, count, smallest, width,
     """The plan of :func:`plan_strips` with the strips too wide cut across into the fewest
     pieces (2 … ``MAX_PIECES``) for which some number of strips fits ``width``; ``whole`` is
     the refusal of whole strips. Refused where one piece more does not make the gaps narrower
-    on average (the strips are wide, not bowed), or more strips than ``max_strips`` would be
-    needed."""
+    on average (the strips are wide, not bowed; a gap too wide at the least span a gap may have
+    is bowed whatever the mean), or more strips than ``max_strips`` would be needed."""
     mean = whole.mean
     for pieces in range(2, MAX_PIECES + 1):
         try:
@@ -167,7 +167,7 @@ def _in_pieces(evaluate, whole: NotNarrowerError, total, count, smallest, width,
                 total, count, smallest, width, max_strips, False,
             )  # fmt: skip
         except NotNarrowerError as refused:
-            if refused.mean >= _NARROWER_PIECES * mean:
+            if not refused.bowed and refused.mean >= _NARROWER_PIECES * mean:
                 break
             mean = refused.mean
     raise NoFitError(f"{whole}; cut across into {pieces} pieces they do not fit either") from None
