@@ -3,8 +3,10 @@ both paths give the same numbers, and a small job loads no numba."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -156,3 +158,69 @@ def test_which_path_a_call_takes():
         assert _jit.compiled(1)
     with _jit.sized_for(False):
         assert not _jit.compiled(10**6)
+
+
+def test_parallel_kernels_give_the_same_numbers_on_any_number_of_threads():
+    """The element kernels share their cells among the cores (``prange``): each cell's results
+    are written by one thread, so one thread and all give the same bits, in the pattern's
+    kernels (energy, gradient, Hessian, projection) and the erection's."""
+    import numba
+
+    from vares.mechanics import forward
+
+    element, metric, pattern = cells("triangle", 3000)
+    gradients = np.random.default_rng(1).normal(size=(3000, 1, 3, 2))
+    weights = np.abs(np.random.default_rng(2).normal(size=(3000, 1)))
+    nodes = np.random.default_rng(3).normal(size=(3000, 3, 3))
+    law = LAWS[0]
+
+    def run():
+        with _jit.sized_for(True):
+            block = block_energy(element, pattern, metric, law, 0.8)
+            projected = projected_hessian(element, block.jacobian_hessian, 0.8)
+        F = forward.deformation_gradients(nodes, gradients)
+        hessian = forward._nodal_hessian(np.ones((3000, 1, 6, 6)), gradients, weights)
+        return [block.energy, block.gradient, block.hessian, projected, F, hessian]
+
+    default = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        single = run()
+    finally:
+        numba.set_num_threads(default)
+    for a, b in zip(single, run(), strict=True):
+        assert np.array_equal(a, b) and np.abs(a).max() > 0
+
+
+def test_parallel_kernels_called_from_several_threads_at_once():
+    """A script or a plug-in may solve from several Python threads. Numba's own thread pool
+    (``workqueue``, where neither TBB nor OpenMP is installed) ends the process when two threads
+    launch parallel kernels at once; the kernels take turns, and every thread gets its result."""
+    script = """
+import threading, sys
+sys.path.insert(0, {tests!r})
+from test_jit import cells
+from conftest import LAWS
+from vares import _jit
+from vares.mechanics.kernels import block_energy
+element, metric, pattern = cells("triangle", 4000)
+out = []
+def work():
+    with _jit.sized_for(True):
+        for _ in range(20):
+            block = block_energy(element, pattern, metric, LAWS[0], 0.8)
+    out.append(float(block.energy.sum()))
+threads = [threading.Thread(target=work) for _ in range(4)]
+[t.start() for t in threads]
+[t.join() for t in threads]
+import numba
+print(numba.threading_layer(), len(out), len(set(out)))
+"""
+    tests = str(Path(__file__).parent)
+    env = {**os.environ, "NUMBA_THREADING_LAYER": "workqueue"}
+    done = subprocess.run(
+        [sys.executable, "-c", script.format(tests=tests)],
+        capture_output=True, text=True, env=env, timeout=600,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["workqueue", "4", "1"]

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import importlib
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -24,10 +25,21 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["COMPILED_FROM", "Kernel", "compiled", "lanes", "njit", "sized_for"]
+__all__ = ["COMPILED_FROM", "Kernel", "compiled", "lanes", "njit", "prange", "sized_for"]
 
 #: Cells (or items) from which a kernel runs compiled; below, its numpy form runs.
 COMPILED_FROM = 2000
+
+#: The loop over the cells of a kernel compiled with ``parallel=True``: numba's ``prange`` once
+#: the kernel is compiled (its cells shared among the cores, each cell's results written by one
+#: thread alone: the same numbers on any number of threads), the builtin ``range`` before (the
+#: numpy form runs one block).
+prange = range
+
+#: Held while a parallel kernel runs: calls from several Python threads at once take turns (each
+#: uses every core anyway), as numba's own thread pool (``workqueue``, where neither TBB nor
+#: OpenMP is installed) ends the process when two threads launch parallel kernels at once.
+_PARALLEL = threading.Lock()
 
 _FORCED: ContextVar[bool | None] = ContextVar("vares_compiled", default=None)
 
@@ -64,7 +76,12 @@ class Kernel:
     def __call__(self, *args: Any) -> Any:
         if self.dispatcher is None:
             numba = importlib.import_module("numba")
+            if self.options.get("parallel"):  # the kernel's module's prange (module docs)
+                self.py_func.__globals__["prange"] = numba.prange
             self.dispatcher = numba.njit(**self.options)(self.py_func)
+        if self.options.get("parallel"):
+            with _PARALLEL:
+                return self.dispatcher(*args)
         return self.dispatcher(*args)
 
 

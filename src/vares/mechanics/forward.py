@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, prange
 from ..geometry.elements import ReferenceElement, determinant, inverse
 from .kernels import BlockResult, project_psd
 
@@ -99,13 +99,13 @@ def forward_projected_hessian(reference: ReferenceBlock, jacobian_hessian: np.nd
     return _nodal_hessian(projected, reference.gradients, reference.weights)
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def deformation_gradients(nodes, gradients):  # pragma: no cover - compiled
     """``F = Σ_a x_a ⊗ ∇_X N_a`` ``(m, q, 3, 2)`` from the erected nodes ``(m, nen, 3)`` and
     the shape functions' pattern gradients ``(m, q, nen, 2)``."""
     m, nq, nen = gradients.shape[0], gradients.shape[1], gradients.shape[2]
     F = np.zeros((m, nq, 3, 2), nodes.dtype)
-    for e in range(m):
+    for e in prange(m):
         for q in range(nq):
             for a in range(nen):
                 g0, g1 = gradients[e, q, a, 0], gradients[e, q, a, 1]
@@ -116,15 +116,15 @@ def deformation_gradients(nodes, gradients):  # pragma: no cover - compiled
     return F
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _derivatives(F, S, tangent, gradients, weights, with_hessian):  # pragma: no cover
     """Nodal gradient ``Σ_q w F S ∇N_a`` and ``∂²W/∂F²`` per unit weight at each point."""
     m, nq, nen = gradients.shape[0], gradients.shape[1], gradients.shape[2]
     dtype = F.dtype
     gradient = np.zeros((m, nen, 3), dtype)
     hessian = np.zeros((m, nq, 6, 6) if with_hessian else (1, 1, 6, 6), dtype)
-    fs = np.empty((3, 2), dtype)
-    for e in range(m):
+    for e in prange(m):
+        fs = np.empty((3, 2), dtype)
         for q in range(nq):
             f = F[e, q]
             s = S[e, q]
@@ -152,12 +152,12 @@ def _derivatives(F, S, tangent, gradients, weights, with_hessian):  # pragma: no
     return gradient, hessian
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _nodal_hessian(jacobian_hessian, gradients, weights):  # pragma: no cover
     """``Σ_q w Bᵀ H B``: nodal Hessian ``(m, nen, 3, nen, 3)`` from ``(m, q, 6, 6)``."""
     m, nq, nen = gradients.shape[0], gradients.shape[1], gradients.shape[2]
     out = np.zeros((m, nen, 3, nen, 3), jacobian_hessian.dtype)
-    for e in range(m):
+    for e in prange(m):
         for q in range(nq):
             h = jacobian_hessian[e, q]
             w = weights[e, q]

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import compiled, lanes, njit
+from .._jit import compiled, lanes, njit, prange
 from ..geometry.elements import ReferenceElement, determinant, inverse
 from ..materials import Fibres, Hyperelastic
 
@@ -220,7 +220,7 @@ def _kinematics(pattern_nodes, shape_gradients, metric, det_j, K, C):  # pragma:
             C[e, q, 1, 1] = k01 * gk01 + k11 * gk11
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _derivatives(
     det_j, K, C, psi, S, tangent, shape_gradients, scale, with_hessian, gradient, jacobian_hessian
 ):  # pragma: no cover
@@ -229,12 +229,12 @@ def _derivatives(
     ``2 i + α`` for ``J_iα``, from the Eshelby form and its directional derivatives."""
     m, nq = det_j.shape[0], det_j.shape[1]
     nen = shape_gradients.shape[1]
-    sigma = np.empty_like(C[0, 0])  # (2, 2) of a cell, or of every cell
-    sigma_kt = np.empty_like(sigma)
-    dC = np.empty_like(sigma)
-    dS = np.empty_like(sigma)
-    d_sigma = np.empty_like(sigma)
-    for e in range(m):
+    for e in prange(m):
+        sigma = np.empty_like(C[0, 0])  # (2, 2) of a cell, or of every cell
+        sigma_kt = np.empty_like(sigma)
+        dC = np.empty_like(sigma)
+        dS = np.empty_like(sigma)
+        d_sigma = np.empty_like(sigma)
         for q in range(nq):
             d = det_j[e, q]
             w = scale[q]
@@ -303,12 +303,12 @@ def _derivatives(
                             jacobian_hessian[e, q, 2 * i + al, 2 * a + b] = d * value
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _nodal_hessian(jacobian_hessian, shape_gradients, scale, hessian):  # pragma: no cover
     """Add ``Σ_q w_q Bᵀ H_q B`` into ``hessian`` ``(m, nen, 2, nen, 2)``."""
     m, nq = jacobian_hessian.shape[0], jacobian_hessian.shape[1]
     nen = shape_gradients.shape[1]
-    for e in range(m):
+    for e in prange(m):
         for q in range(nq):
             h = jacobian_hessian[e, q]
             w = scale[q]
@@ -327,13 +327,13 @@ def _nodal_hessian(jacobian_hessian, shape_gradients, scale, hessian):  # pragma
                             hessian[e, a, kk, b, ll] += w * value
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _project_psd(jacobian_hessian):  # pragma: no cover
     """:func:`project_psd` by cyclic Jacobi, block by block."""
     n = jacobian_hessian.shape[2]
-    a = np.empty((n, n))
-    v = np.empty((n, n))
-    for e in range(jacobian_hessian.shape[0]):
+    for e in prange(jacobian_hessian.shape[0]):
+        a = np.empty((n, n))
+        v = np.empty((n, n))
         for q in range(jacobian_hessian.shape[1]):
             h = jacobian_hessian[e, q]
             dominant = True
