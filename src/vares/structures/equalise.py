@@ -78,7 +78,7 @@ class _Count:
         self.plan: StripPlan | None = None
         self.spans = self.widths = self.following = self.start = np.zeros(0)
         self.evaluations, self.equal = 0, False
-        self.bowed: tuple[float, float] | None = None  # a gap too wide at the floor: width, span
+        self.bowed: float | None = None  # the width of a gap too wide at the least span
 
     @property
     def widest(self) -> float:
@@ -99,7 +99,7 @@ class _Count:
             self.evaluations += 1
             widest = int(np.argmax(widths))
             if widths[widest] > width and spans[widest] <= (1 + 1e-9) * _floor(total, len(spans)):
-                self.bowed = (float(widths[widest]), float(spans[widest]))
+                self.bowed = float(widths[widest])
             if self.plan is None or widths.max() < self.widest:
                 self.plan, self.spans, self.widths = candidate, spans, widths
             if widths.max() <= _EQUAL * widths.min():
@@ -159,12 +159,11 @@ def _bowing(trial: _Count, width: float, interlock: bool) -> None:
     (:data:`_FLOOR`): its strips bow, and more lines will not make them fit."""
     if trial.bowed is None:
         return
-    wide, _ = trial.bowed
     kind = "strips in pairs" if interlock else "strips"
     raise NotNarrowerError(
         f"{kind} do not get narrower with their number: of {len(trial.spans)} gaps between "
         f"cutting lines, one a tenth as wide as their mean spacing still leaves a strip "
-        f"{wide:.4g} wide (strips at most {width:g} wide): "
+        f"{trial.bowed:.4g} wide (strips at most {width:g} wide): "
         + (
             "plan them one after the other (interlock never)"
             if interlock
