@@ -154,24 +154,34 @@ def _respaced(
     return _floored(np.diff(bounds) * (total / bounds[-1]), total)
 
 
+def _not_narrower(
+    what: str, width: float, interlock: bool, mean: float, bowed: bool = False
+) -> NotNarrowerError:
+    """The refusal of strips that do not get narrower with their number: ``what`` was measured
+    (strips at most ``width`` wide), and what to try instead."""
+    kind = "strips in pairs" if interlock else "strips"
+    advice = (
+        "plan them one after the other (interlock never)"
+        if interlock
+        else "their flattened strips bow; try another strip direction or layout"
+    )
+    return NotNarrowerError(
+        f"{kind} do not get narrower with their number: {what} (strips at most {width:g} "
+        f"wide): {advice}",
+        mean,
+        bowed,
+    )
+
+
 def _bowing(trial: _Count, width: float, interlock: bool) -> None:
     """Raise if a gap of ``trial`` was too wide for ``width`` at the least span a gap may have
     (:data:`_FLOOR`): its strips bow, and more lines will not make them fit."""
-    if trial.bowed is None:
-        return
-    kind = "strips in pairs" if interlock else "strips"
-    raise NotNarrowerError(
-        f"{kind} do not get narrower with their number: of {len(trial.spans)} gaps between "
-        f"cutting lines, one a tenth as wide as their mean spacing still leaves a strip "
-        f"{trial.bowed:.4g} wide (strips at most {width:g} wide): "
-        + (
-            "plan them one after the other (interlock never)"
-            if interlock
-            else "its flattened strips bow; try another strip direction or layout"
-        ),
-        float(trial.widths.mean()),
-        bowed=True,
-    )
+    if trial.bowed is not None:
+        raise _not_narrower(
+            f"of {len(trial.spans)} gaps between cutting lines, one a tenth as wide as their "
+            f"mean spacing still leaves a strip {trial.bowed:.4g} wide",
+            width, interlock, float(trial.widths.mean()), bowed=True,
+        )  # fmt: skip
 
 
 def _narrowing(tried: dict[int, _Count], count: int, width: float, interlock: bool) -> None:
@@ -183,18 +193,11 @@ def _narrowing(tried: dict[int, _Count], count: int, width: float, interlock: bo
     mean = tried[count].widths.mean()
     for fewer, trial in tried.items():
         if 2 * fewer <= count and trial.widest > width and mean > _NARROWER * trial.widths.mean():
-            kind = "strips in pairs" if interlock else "strips"
-            raise NotNarrowerError(
-                f"{kind} do not get narrower with their number: {fewer} gaps between cutting "
-                f"lines are {trial.widths.mean():.4g} wide on average, {count} gaps "
-                f"{mean:.4g} (strips at most {width:g} wide)"
-                + (
-                    ": plan them one after the other (interlock never)"
-                    if interlock
-                    else ": their flattened strips bow; try another strip direction or layout"
-                ),
-                mean,
-            )
+            raise _not_narrower(
+                f"{fewer} gaps between cutting lines are {trial.widths.mean():.4g} wide on "
+                f"average, {count} gaps {mean:.4g}",
+                width, interlock, mean,
+            )  # fmt: skip
 
 
 def least_count(
