@@ -15,6 +15,7 @@ from conftest import FIBRES, LAWS
 from vares import _jit
 from vares.geometry.elements import ELEMENTS
 from vares.io.raster import rasterise
+from vares.materials import Hyperelastic
 from vares.mechanics import Assembler
 from vares.mechanics.kernels import block_energy, project_psd, projected_hessian
 
@@ -64,6 +65,51 @@ def test_element_kernels_are_the_same_compiled_and_as_numpy(cell_type, law):
     projected = both_paths(lambda: projected_hessian(element, compiled.jacobian_hessian, 0.8))
     scale = np.abs(projected[0]).max()
     np.testing.assert_allclose(projected[1], projected[0], rtol=1e-12, atol=1e-12 * scale)
+
+
+class _SquaredFibreLaw(Hyperelastic):
+    """A law of every kind of invariant derivative: constant (I1), per point (I3, I5, I7),
+    with constant second derivatives (I3, I5, I7), coupled (I1 with I5)."""
+
+    invariants = ("I1", "I3", "I5", "I7")
+    stiffness_scale = 1.0
+
+    def psi_invariants(self, inv):
+        i1, i3, i5, i7 = np.moveaxis(inv, -1, 0)
+        return 0.5 * (i1 - 2) ** 2 - np.log(i3) + 0.3 * i5 * i1 + 0.2 * i7**2
+
+    def dpsi_invariants(self, inv):
+        i1, i3, i5, i7 = np.moveaxis(inv, -1, 0)
+        return np.stack([i1 - 2 + 0.3 * i5, -1 / i3, 0.3 * i1, 0.4 * i7], axis=-1)
+
+    def d2psi_invariants(self, inv):
+        out = np.zeros((*inv.shape, 4))
+        out[..., 0, 0], out[..., 1, 1] = 1.0, 1 / inv[..., 1] ** 2
+        out[..., 0, 2] = out[..., 2, 0] = 0.3
+        out[..., 3, 3] = 0.4
+        return out
+
+
+@pytest.mark.parametrize(
+    "law", [*LAWS, _SquaredFibreLaw()], ids=lambda m: type(m).__name__.strip("_")
+)
+def test_the_material_response_is_the_same_compiled_and_as_numpy(law):
+    """``S`` and ``ℂ`` from the invariants' derivatives: the compiled sums are the numpy
+    form's, in the same order, to the bit (cells on the leading axis, quadrature points next)."""
+    rng = np.random.default_rng(4)
+    A = np.eye(2) + 0.1 * rng.normal(size=(2500, 3, 2, 2))
+    C = np.swapaxes(A, -1, -2) @ A
+    fibres = FIBRES if law.needs_fibres else None
+    for tangent in (True, False):
+        compiled, numpy = both_paths(lambda t=tangent: law.response(C, fibres, tangent=t))
+        assert compiled.stress.shape == C.shape and np.abs(compiled.stress).max() > 0
+        np.testing.assert_array_equal(compiled.psi, numpy.psi)
+        np.testing.assert_array_equal(compiled.stress, numpy.stress)
+        if tangent:
+            assert compiled.tangent.shape == (*C.shape, 2, 2)
+            np.testing.assert_array_equal(compiled.tangent, numpy.tangent)
+        else:
+            assert compiled.tangent is None and numpy.tangent is None
 
 
 def test_the_positive_part_of_blocks_is_the_same_compiled_and_as_numpy():

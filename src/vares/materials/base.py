@@ -21,6 +21,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from .._jit import compiled, njit, prange
+
 __all__ = ["INVARIANTS", "Fibres", "Hyperelastic", "MaterialError", "MaterialResponse"]
 
 #: Names of the invariants a law may use, in the order of DESIGN.md §2.
@@ -197,11 +199,15 @@ class Hyperelastic(ABC):
         inv, first, second = invariants(C, self.invariants, fibres)
         psi = self.psi_invariants(inv)
         dpsi = self.dpsi_invariants(inv)
+        d2psi = self.d2psi_invariants(inv) if tangent else None
+        # compiled from as many cells (the leading axis) as the element kernels
+        if C.ndim > 2 and compiled(len(C)) and np.isrealobj(C) and np.isrealobj(dpsi):
+            stress, cc = _derived_compiled(C.shape, first, second, dpsi, d2psi)
+            return MaterialResponse(psi, stress, cc)
         stress = sum(2.0 * dpsi[..., k, None, None] * first[k] for k in range(len(first)))
         stress = np.broadcast_to(stress, C.shape)
         if not tangent:
             return MaterialResponse(psi, stress, None)
-        d2psi = self.d2psi_invariants(inv)
         cc = np.zeros((*C.shape, 2, 2), dtype=np.result_type(C, psi))
         for k, dk in enumerate(first):
             for ell, dl in enumerate(first):
@@ -229,6 +235,79 @@ class Hyperelastic(ABC):
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
         return f"{type(self).__name__}({args})"
+
+
+def _derived_compiled(shape, first, second, dpsi, d2psi):
+    """``S`` and ``ℂ`` (None without ``d2psi``) of :meth:`Hyperelastic.response` by the compiled
+    :func:`_derived`: the same sums in the same order, so the same numbers as the numpy form."""
+    points, count = int(np.prod(shape[:-2])), len(first)
+    gradients = np.empty((points, count, 2, 2))
+    for k, dk in enumerate(first):
+        gradients[:, k] = np.reshape(np.broadcast_to(dk, shape), (points, 2, 2))
+    constants = np.zeros((count, 2, 2, 2, 2))
+    has_second = np.zeros(count, dtype=np.bool_)
+    for k, sk in enumerate(second):
+        if sk is not None:
+            constants[k], has_second[k] = sk, True
+    first_derivatives = np.reshape(np.broadcast_to(dpsi, (*shape[:-2], count)), (points, count))
+    stress = np.empty((points, 2, 2))
+    if d2psi is None:
+        second_derivatives, pairs = np.zeros((points, count, count)), np.zeros((count, count), bool)
+        tangent = np.empty((0, 2, 2, 2, 2))
+    else:
+        second_derivatives = np.reshape(
+            np.broadcast_to(d2psi, (*shape[:-2], count, count)), (points, count, count)
+        )
+        pairs = np.any(second_derivatives, axis=0)  # the numpy form skips a pair zero everywhere
+        tangent = np.empty((points, 2, 2, 2, 2))
+    _derived(  # copies: one signature whatever the laws' arrays are (views, read-only)
+        np.array(first_derivatives, dtype=float, order="C"),
+        np.array(second_derivatives, dtype=float, order="C"),
+        gradients,
+        constants,
+        has_second,
+        pairs,
+        d2psi is not None,
+        stress,
+        tangent,
+    )
+    stress = stress.reshape(shape)
+    return stress, (None if d2psi is None else tangent.reshape((*shape, 2, 2)))
+
+
+@njit(cache=True, parallel=True)
+def _derived(
+    dpsi, d2psi, gradients, constants, has_second, pairs, with_tangent, stress, tangent
+):  # pragma: no cover
+    """``S = Σ_k 2 ∂Ψ/∂I_k ∂I_k/∂C`` and ``ℂ = Σ_kl 4 ∂²Ψ/∂I_k∂I_l ∂I_k/∂C ⊗ ∂I_l/∂C + Σ_k 4
+    ∂Ψ/∂I_k ∂²I_k/∂C∂C`` point by point (``gradients`` ``(n, k, 2, 2)``: ``∂I_k/∂C``;
+    ``constants`` ``(k, 2, 2, 2, 2)``: ``∂²I_k/∂C∂C`` where ``has_second``; ``pairs``: the
+    ``(k, l)`` whose ``∂²Ψ/∂I_k∂I_l`` is not zero everywhere)."""
+    count = dpsi.shape[1]
+    for p in prange(dpsi.shape[0]):
+        for a in range(2):
+            for b in range(2):
+                value = 0.0
+                for k in range(count):
+                    value += 2.0 * dpsi[p, k] * gradients[p, k, a, b]
+                stress[p, a, b] = value
+        if not with_tangent:
+            continue
+        for a in range(2):
+            for b in range(2):
+                for c in range(2):
+                    for d in range(2):
+                        value = 0.0
+                        for k in range(count):
+                            for ell in range(count):
+                                if pairs[k, ell]:
+                                    value += (4.0 * d2psi[p, k, ell]) * (
+                                        gradients[p, k, a, b] * gradients[p, ell, c, d]
+                                    )
+                            if has_second[k]:
+                                value += (4.0 * dpsi[p, k]) * constants[k, a, b, c, d]
+                        tangent[p, a, b, c, d] = value
+    return 0
 
 
 def check_positive(**values: float) -> None:

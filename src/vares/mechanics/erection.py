@@ -210,12 +210,13 @@ class ErectionProblem:
                 and stabilised
                 and not self.film_in_energy
             ):
-                hessian = hessian + self._film[index]
+                hessian += self._film[index]  # (the block's own new array: added in place)
             if self.pressure:
                 load = pressure_terms(nodes, self.pressure, order)
                 total += np.sum(load[0]).real
                 gradient = None if order == 0 else gradient + load[1]
-                hessian = None if order < 2 else hessian + load[2]
+                if order >= 2:
+                    hessian += load[2]
             gradients.append(gradient)
             hessians.append(hessian)
             jacobian_hessians.append(result.jacobian_hessian)
@@ -254,7 +255,8 @@ class ErectionProblem:
             for b, h in zip(self.blocks, evaluation.jacobian_hessians, strict=True)
         ]
         if self._film is not None and not self.film_in_energy:
-            out = [h + film for h, film in zip(out, self._film, strict=True)]
+            for h, film in zip(out, self._film, strict=True):
+                h += film  # (new arrays: added in place)
         if evaluation.cable_hessian is not None:
             out.append(evaluation.cable_hessian)
         return out
