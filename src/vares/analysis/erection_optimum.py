@@ -57,7 +57,7 @@ import scipy.sparse.linalg as spla
 
 from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
-from ..solver.linear import quiet_blas
+from ..solver.linear import quiet_blas, solver_family
 from ..solver.options import SolveOptions
 from .erection import erect
 from .erection_bound import AT_BOUND, HeldNodes, ShapeBound
@@ -196,8 +196,12 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
     held = None if shape_bound is None else ShapeBound(shape_bound * first.deviation()["max"])
     bound = None if held is None else held.bound
 
+    # the states' tangents factorised by solvers of one family: one symbolic analysis for all,
+    # apart from the trial erections' own factorisations
+    tangents = solver_family(solver.linear_solver, many_solves=True)
+
     def model_of(p, e):
-        return ResidualModel(p, e, layout, seams, scales, shape_weight, bound, solver.linear_solver)
+        return ResidualModel(p, e, layout, seams, scales, shape_weight, bound, tangents)
 
     current, erected = patterns, first
     model = model_of(current, erected)

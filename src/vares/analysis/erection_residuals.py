@@ -13,6 +13,7 @@ are constraints beside it: every seam edge equally long in the two patterns it j
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -22,7 +23,7 @@ import scipy.sparse.linalg as spla
 from ..materials import Hyperelastic
 from ..mechanics.assembly import Assembler
 from ..mechanics.problem import Problem
-from ..solver.linear import get_solver
+from ..solver.linear import LinearSolver, get_solver
 from .erection import ErectionResult
 from .erection_fields import node_normals
 from .erection_model import Pattern
@@ -156,9 +157,11 @@ class ResidualModel:
         scales: tuple[float, float],
         shape_weight: float,
         shape_bound: float | None,
-        linear_solver: str | None,
+        linear_solver: str | Callable[[], LinearSolver] | None,
     ) -> None:
         self.erected, self.layout, self.seams = erected, layout, seams
+        #: a solver's name (None: the fastest installed), or what makes the solver the tangent
+        #: is factorised by (an optimiser's models share a family: :func:`solver_family`)
         self.linear_solver = linear_solver
         problem, x, mesh = erected.problem, erected.erected_points, erected.mesh
         area = mesh.cell_areas()
@@ -294,7 +297,8 @@ class ResidualModel:
         taut = not erected.fields["state"].any()
         evaluation = problem.evaluate(x, order=2, stabilised=not taut)
         self.tangent = ctx.assembler.matrix(evaluation.hessians)
-        self.solver = get_solver(self.linear_solver)
+        make = self.linear_solver
+        self.solver = make() if callable(make) else get_solver(make, many_solves=True)
         self.solver.factorize(self.tangent)
         self._linear = True
 
@@ -407,7 +411,8 @@ def stiffness_preconditioner(
     of their stiffness is one the erected forces follow evenly, and LSQR needs about a third of
     the iterations for the same step (docs/erection.md). The patterns move by a few per cent
     while they are optimised: the factors of the starting patterns serve every step. Factorised
-    by ``linear_solver`` (None: the fastest installed), with factors of its own."""
+    by ``linear_solver`` (None: the fastest installed), with factors of its own, for the many
+    solves they serve."""
     blocks = []
     for pattern in patterns:
         problem = Problem(pattern.mesh, material, thickness, fibres=pattern.fibres)
@@ -418,7 +423,7 @@ def stiffness_preconditioner(
     H = sp.block_diag(blocks, format="csr")
     shifted = (H + PRECONDITIONER_SHIFT * H.diagonal().mean() * sp.eye(H.shape[0])).tocsr()
     # factors of its own: the erection tangent's are made and solved with between its solves
-    solver = get_solver(linear_solver, own_factors=True)
+    solver = get_solver(linear_solver, own_factors=True, many_solves=True)
     solver.factorize(shifted)
     return spla.LinearOperator(H.shape, matvec=solver.solve, rmatvec=solver.solve, dtype=float)
 
