@@ -363,6 +363,12 @@ def test_a_family_of_pardiso_solvers_shares_one_analysis_apart_from_other_solver
         rhs = rng.normal(size=60)
         np.testing.assert_allclose(matrices[0] @ solver.solve(rhs), rhs, atol=1e-10)
     assert [s for s, phase in phases if phase == 11][-3:] == [default, nested, default]
+    release = members[0]._state.release  # the family's handle given back with its last solver
+    assert release.alive
+    del family, members, member, analyses, numeric
+    phases.clear()
+    gc.collect()
+    assert not release.alive
 
 
 @pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO is not installed")

@@ -298,7 +298,10 @@ class ResidualModel:
         evaluation = problem.evaluate(x, order=2, stabilised=not taut)
         self.tangent = ctx.assembler.matrix(evaluation.hessians)
         make = self.linear_solver
-        self.solver = make() if callable(make) else get_solver(make, many_solves=True)
+        if callable(make):
+            self.solver = make()
+        else:  # a handle of its own: the thread's keeps its erections' analysis
+            self.solver = get_solver(make, own_factors=True, many_solves=True)
         self.solver.factorize(self.tangent)
         self._linear = True
 

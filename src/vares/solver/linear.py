@@ -187,9 +187,10 @@ class PardisoSolver:
 
     Settings (chosen by measurement, docs/benchmarks.md): minimum-degree ordering below
     :data:`NESTED_DISSECTION_ABOVE` unknowns (its analysis is 3× faster and its fill no larger
-    on surface meshes), parallel nested dissection above, and for a solver whose factors serve
-    many solves each (``many_solves``: an optimiser's adjoint products, a preconditioner), whose
-    solves it makes 25–40 % faster; Bunch–Kaufman pivoting with pivots
+    on surface meshes), parallel nested dissection above; for a solver whose factors serve many
+    solves each (``many_solves``: an optimiser's adjoint products, a preconditioner) nested
+    dissection and the two-level factorisation, whose solves are 30–45 % faster
+    (:meth:`_settings`); Bunch–Kaufman pivoting with pivots
     perturbed below 1e-8 (PARDISO refines a solve itself when it perturbed one); no scaling or
     matching (the tangent is symmetric and well scaled).
     """
@@ -311,7 +312,7 @@ class PardisoSolver:
 
 
 def _analysed(state: HandleState, analysis: tuple) -> bool:
-    """Whether ``state``'s handle holds the symbolic analysis ``analysis`` (pattern, ordering)."""
+    """Whether ``state``'s handle holds the symbolic analysis ``analysis`` (pattern, settings)."""
     known = state.analysed
     return known is not None and known[1] == analysis[1] and _same_pattern(known[0], analysis[0])
 
@@ -344,12 +345,14 @@ def _pardiso_state() -> PardisoState:
     return state
 
 
-def _own_pardiso_state(owner: PardisoSolver) -> HandleState:
+def _own_pardiso_state(owner: PardisoSolver | None) -> HandleState:
     """A PARDISO handle for ``owner`` alone (its factors stay while the thread's handle
-    factorises other matrices), its memory given back to MKL when ``owner`` is collected."""
+    factorises other matrices), its memory given back to MKL when ``owner`` is collected
+    (``None``: when the state itself is, its solvers keeping it)."""
     state = HandleState()
     state.handle = _pardiso_handle()
-    state.release = weakref.finalize(owner, state.handle.free_memory, everything=True)
+    keeper = state if owner is None else owner
+    state.release = weakref.finalize(keeper, state.handle.free_memory, everything=True)
     return state
 
 
@@ -588,19 +591,8 @@ def solver_family(name: str | None = None, many_solves: bool = False) -> Callabl
     name = _installed(name)
     if name != PardisoSolver.name:
         return _SOLVERS[name]
-    owner = _Family()
-    state = _own_pardiso_state(owner)
-    return lambda: _member(owner, state, many_solves)
-
-
-class _Family:
-    """What keeps a :func:`solver_family`'s handle alive: each member refers to it."""
-
-
-def _member(owner: _Family, state: HandleState, many_solves: bool) -> PardisoSolver:
-    solver = PardisoSolver(many_solves=many_solves, state=state)
-    solver._family = owner  # the handle is given back when the family's last member is gone
-    return solver
+    state = _own_pardiso_state(None)  # given back when the maker and its solvers are gone
+    return lambda: PardisoSolver(many_solves=many_solves, state=state)
 
 
 def _installed(name: str | None) -> str:
