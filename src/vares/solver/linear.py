@@ -189,7 +189,7 @@ class PardisoSolver:
     :data:`NESTED_DISSECTION_ABOVE` unknowns (its analysis is 3× faster and its fill no larger
     on surface meshes), parallel nested dissection above; for a solver whose factors serve many
     solves each (``many_solves``: an optimiser's adjoint products, a preconditioner) nested
-    dissection and the two-level factorisation, whose solves are 30–45 % faster
+    dissection and the two-level factorisation, whose solves are 25–50 % faster
     (:meth:`_settings`); Bunch–Kaufman pivoting with pivots
     perturbed below 1e-8 (PARDISO refines a solve itself when it perturbed one); no scaling or
     matching (the tangent is symmetric and well scaled).
@@ -216,12 +216,11 @@ class PardisoSolver:
     def _settings(self, size: int) -> tuple[int, int]:
         """PARDISO's ``iparm(2)`` and ``iparm(24)`` for a matrix of ``size`` unknowns (class
         docs). ``iparm(2)``: 0 minimum degree, 3 parallel nested dissection, 2 METIS' nested
-        dissection on one thread for ``many_solves`` (the parallel one orders differently from
-        run to run; on the 50k erection tangent it was no faster, 0.26 s for either analysis).
-        ``iparm(24)`` 1, the two-level factorisation, for ``many_solves``: its solves are 30 %
-        faster again and, with nested dissection, the same from factorisation to factorisation
-        (the classic one's differed in round-off from one factorisation of the same matrix to
-        the next, and an optimisation's steps with them)."""
+        dissection for ``many_solves`` (0.26 s for either analysis of the 50k erection tangent).
+        ``iparm(24)`` 1, the two-level factorisation, for ``many_solves``: with nested
+        dissection its solves are 25–50 % faster than minimum degree's, and the same bits from
+        one factorisation of a matrix to the next (with the classic factorisation they differed
+        in round-off, and an optimisation's steps with them; tests/test_linear.py)."""
         ordering = 3 if size > NESTED_DISSECTION_ABOVE else (2 if self._many_solves else 0)
         return ordering, (1 if self._many_solves else 0)
 
