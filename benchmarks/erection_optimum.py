@@ -122,8 +122,7 @@ def row(mesh, variant: str, optimum, times) -> None:
     after = optimum.erected.statistics()["stress"]
     lsqr = sum(r.lsqr_iterations for r in optimum.history)
     # every erection's Newton iterations: the start's, the trials' and the optimum's tightening
-    newton = optimum.start.iterations + sum(r.erection_iterations for r in optimum.history)
-    newton += optimum.tightening or 0
+    newton = optimum.start.iterations + optimum.newton_iterations
     objective = f"{optimum.history[0].objective:.3f}→{optimum.history[-1].objective:.4f}"
 
     def pair(key, yarn, a=before, b=after):

@@ -352,3 +352,34 @@ def test_erection_comparison_columns_design_shape_then_erected():
     assert table["slack area"] == ["0.0 %", "5.0 %"]
     assert table["normal deviation, max / RMS (m)"] == ["0 / 0", "0.0123 / 0.00456"]
     assert table["area (m²)"] == ["10", "9.5"]
+
+
+def test_the_console_names_the_vares_patterns_erection_beside_the_optimisation(monkeypatch):
+    """With --optimise the console's first erection line is the VaReS patterns' own erection
+    (its iterations and time), and the optimisation's line counts the Newton iterations of its
+    erections; the optimised patterns' final erection (finished from the last trial, an
+    iteration or two) is not shown as if it were the structure's erection."""
+    from rich.console import Console
+
+    from vares.app.cli import common
+
+    mesh = vares.examples.hypar(size=10.0, rise=0.06, n=12)
+    solved = vares.solve(mesh, vares.materials.StVenantKirchhoff(E=600.0, nu=0.3), prestress=2.0)
+    optimum = vares.optimise_for_erection(solved)
+    assert optimum.start.iterations != optimum.erected.iterations  # else the test says nothing
+    console = Console(record=True, width=300)
+    monkeypatch.setattr(common, "console", console)
+    common.show_erection(optimum.erected, "m", optimum)
+    text = console.export_text()
+    assert (
+        f"erection of the VaReS patterns, 1 panel(s), {mesh.num_points} nodes" in text
+        and f"converged in {optimum.start.iterations} iterations" in text
+    )
+    newton = sum(r.erection_iterations for r in optimum.history) + (optimum.tightening or 0)
+    assert f"{optimum.iterations} steps, {newton} Newton iterations of their erections" in text
+    # the report's key table says the same
+    from vares.app.erection_report import erection_section
+
+    html = "".join(erection_section(optimum.erected, "m", None, optimum))
+    assert f'VaReS patterns</th><td class="num">{optimum.start.iterations} Newton' in html
+    assert f"{newton} Newton iterations of their erections" in html

@@ -83,7 +83,7 @@ class _SquaredFibreLaw(Hyperelastic):
         return np.stack([i1 - 2 + 0.3 * i5, -1 / i3, 0.3 * i1, 0.4 * i7], axis=-1)
 
     def d2psi_invariants(self, inv):
-        out = np.zeros((*inv.shape, 4))
+        out = np.zeros((*inv.shape, 4), dtype=inv.dtype)
         out[..., 0, 0], out[..., 1, 1] = 1.0, 1 / inv[..., 1] ** 2
         out[..., 0, 2] = out[..., 2, 0] = 0.3
         out[..., 3, 3] = 0.4

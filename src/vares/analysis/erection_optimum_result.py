@@ -62,6 +62,12 @@ class OptimisedPatterns:
     def iterations(self) -> int:
         return sum(1 for r in self.history if r.iteration > 0)
 
+    @property
+    def newton_iterations(self) -> int:
+        """The Newton iterations of the erections made after the start's: the trials' and the
+        optimum's final one."""
+        return sum(r.erection_iterations for r in self.history) + (self.tightening or 0)
+
     def to_dict(self) -> dict[str, object]:
         """What ``erect.json`` holds under ``optimisation``: the optimiser's settings and
         iterations, and the erected figures of the starting (VaReS) patterns beside which the
@@ -70,6 +76,7 @@ class OptimisedPatterns:
             "converged": self.converged,
             "reason": self.reason,
             "iterations": self.iterations,
+            "newton_iterations": self.newton_iterations,
             "shape_weight": self.shape_weight,
             "shape_bound": self.shape_bound,
             "elapsed_seconds": self.elapsed,

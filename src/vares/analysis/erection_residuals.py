@@ -23,7 +23,7 @@ import scipy.sparse.linalg as spla
 from ..materials import Hyperelastic
 from ..mechanics.assembly import Assembler
 from ..mechanics.problem import Problem
-from ..solver.linear import LinearSolver, get_solver
+from ..solver.linear import LinearSolver, get_solver, solver_family
 from .erection import ErectionResult
 from .erection_fields import node_normals
 from .erection_model import Pattern
@@ -160,9 +160,14 @@ class ResidualModel:
         linear_solver: str | Callable[[], LinearSolver] | None,
     ) -> None:
         self.erected, self.layout, self.seams = erected, layout, seams
-        #: a solver's name (None: the fastest installed), or what makes the solver the tangent
-        #: is factorised by (an optimiser's models share a family: :func:`solver_family`)
-        self.linear_solver = linear_solver
+        #: what makes the solver the tangent is factorised by: a family's maker (an optimiser's
+        #: states share one, :func:`solver_family`), or a family of its own for a solver's name
+        #: (None: the fastest installed)
+        self.solvers = (
+            linear_solver
+            if callable(linear_solver)
+            else solver_family(linear_solver, many_solves=True)
+        )
         problem, x, mesh = erected.problem, erected.erected_points, erected.mesh
         area = mesh.cell_areas()
         total = area.sum()
@@ -297,11 +302,7 @@ class ResidualModel:
         taut = not erected.fields["state"].any()
         evaluation = problem.evaluate(x, order=2, stabilised=not taut)
         self.tangent = ctx.assembler.matrix(evaluation.hessians)
-        make = self.linear_solver
-        if callable(make):
-            self.solver = make()
-        else:  # a handle of its own: the thread's keeps its erections' analysis
-            self.solver = get_solver(make, own_factors=True, many_solves=True)
+        self.solver = self.solvers()
         self.solver.factorize(self.tangent)
         self._linear = True
 

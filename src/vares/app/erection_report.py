@@ -99,14 +99,22 @@ def erection_section(
         ("supports", f"{int(result.held.sum())} nodes held"),
         ("wrinkling", "tension field (no compression)" if result.options.wrinkling else "off"),
         ("pressure", number(result.options.pressure)),
-        ("Newton iterations", result.iterations),
-        ("time", f"{result.elapsed:.2f} s"),
     ]
-    if optimum is not None:
+    if optimum is None:
+        key += [("Newton iterations", result.iterations), ("time", f"{result.elapsed:.2f} s")]
+    else:  # ``result`` is the optimum's erection, finished from the optimiser's last trial
+        start = optimum.start
+        key.append(
+            (
+                "erection of the VaReS patterns",
+                f"{start.iterations} Newton iterations, {start.elapsed:.2f} s",
+            )
+        )
         key.append(
             (
                 "patterns optimised for the erected structure",
-                f"{optimum.iterations} steps, {optimum.elapsed:.2f} s (shape weight "
+                f"{optimum.iterations} steps, {optimum.newton_iterations} Newton iterations of "
+                f"their erections, {optimum.elapsed:.2f} s (shape weight "
                 f"{optimum.shape_weight:g}, shape bound {optimum.shape_bound}"
                 + ("" if optimum.converged else f"; not optimised: {optimum.reason}")
                 + ")",

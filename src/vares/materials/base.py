@@ -251,8 +251,8 @@ def _derived_compiled(shape, first, second, dpsi, d2psi):
             constants[k], has_second[k] = sk, True
     first_derivatives = np.reshape(np.broadcast_to(dpsi, (*shape[:-2], count)), (points, count))
     stress = np.empty((points, 2, 2))
-    if d2psi is None:
-        second_derivatives, pairs = np.zeros((points, count, count)), np.zeros((count, count), bool)
+    if d2psi is None:  # nothing of these is read
+        second_derivatives, pairs = np.zeros((1, count, count)), np.zeros((count, count), bool)
         tangent = np.empty((0, 2, 2, 2, 2))
     else:
         second_derivatives = np.reshape(

@@ -304,15 +304,19 @@ def show_erection(
 ) -> None:
     """Print what an erection did: status, and design shape against erected (with ``optimum``,
     the VaReS patterns' erection beside the optimised patterns')."""
-    status = "[green]converged[/]" if result.converged else f"[red]failed[/]: {result.reason}"
+    # with an optimum, ``result`` is the optimised patterns' erection, finished from the
+    # optimiser's last trial: the VaReS patterns' own erection is the one to report first
+    first = result if optimum is None else optimum.start
+    status = "[green]converged[/]" if first.converged else f"[red]failed[/]: {first.reason}"
     console.print(
-        f"erection of {len(result.panels)} panel(s), {result.mesh.num_points} nodes "
-        f"({int(result.held.sum())} held): {status} in {result.iterations} iterations, "
-        f"{result.elapsed:.2f} s"
+        f"erection of {'the VaReS patterns, ' if optimum else ''}{len(first.panels)} panel(s), "
+        f"{first.mesh.num_points} nodes ({int(first.held.sum())} held): {status} in "
+        f"{first.iterations} iterations, {first.elapsed:.2f} s"
     )
     if optimum is not None:
         console.print(
             f"patterns optimised for the erected structure: {optimum.iterations} steps, "
+            f"{optimum.newton_iterations} Newton iterations of their erections, "
             f"{optimum.elapsed:.2f} s"
             + ("" if optimum.converged else f" ([red]not optimised[/]: {optimum.reason})")
         )
