@@ -2,6 +2,8 @@
 roll width, cut outlines with allowances per edge and nesting on the roll."""
 
 import itertools
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +24,10 @@ from vares.geometry.surface_lines import (
     plane_sections,
     triangulated,
 )
-from vares.structures import find_seams, split_panels
+from vares.structures import find_seams, nesting, split_panels
 from vares.structures.layout import CELLS_ACROSS, plan_strips
 from vares.structures.nesting import (
+    NestError,
     clearance_of,
     nest_pieces,
     single_precision_step,
@@ -177,17 +180,37 @@ def test_allowance_outline_per_edge():
     assert Polygon(allowance_outline(hexagon, 0.05)).symmetric_difference(buffered).area < 1e-12
 
 
-@pytest.mark.parametrize("turn", [True, False])
-def test_nesting_never_overlaps_and_stays_on_the_roll(turn):
+def tapered_pieces(count: int = 7) -> tuple[list[np.ndarray], list[float]]:
+    """``count`` tapered pieces 3–8 long, 0.8–1.4 wide at one end, scattered; their areas."""
     rng = np.random.default_rng(3)
     pieces, areas = [], []
-    for _ in range(7):
+    for _ in range(count):
         length, wide, narrow = rng.uniform(3, 8), rng.uniform(0.8, 1.4), rng.uniform(0.2, 0.6)
         shape = np.array(
             [[0, 0], [length, 0.5 * (wide - narrow)], [length, 0.5 * (wide + narrow)], [0, wide]]
         )
         pieces.append(shape + rng.uniform(-5, 5, 2))
         areas.append(Polygon(shape).area)
+    return pieces, areas
+
+
+def search_processes() -> list[int]:
+    """The nesting searches this process has running (Linux: from /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            parent = int(stat.read_text().rsplit(")", 1)[1].split()[1])
+            command = (stat.parent / "cmdline").read_bytes()
+        except (OSError, IndexError, ValueError):
+            continue  # a process that ended meanwhile
+        if parent == os.getpid() and b"_nest_search" in command:
+            found.append(int(stat.parent.name))
+    return found
+
+
+@pytest.mark.parametrize("turn", [True, False])
+def test_nesting_never_overlaps_and_stays_on_the_roll(turn):
+    pieces, areas = tapered_pieces()
     nest = nest_pieces(pieces, 2.5, net_areas=areas, allow_turn=turn, time_limit=1, seed=1)
     placed = [Polygon(p.place(pieces[p.index])) for p in nest.pieces]
     assert sorted(p.index for p in nest.pieces) == list(range(7))
@@ -200,6 +223,46 @@ def test_nesting_never_overlaps_and_stays_on_the_roll(turn):
     # two rows fit across the roll: far shorter than the pieces laid end to end
     assert nest.length < 0.6 * sum(np.ptp(p[:, 0]) for p in pieces)
     assert all(p.rotation in ((0.0, 180.0) if turn else (0.0,)) for p in nest.pieces)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_the_time_bound_stops_the_search_and_lays_its_shortest_nest():
+    """The search runs in a process of its own, stopped at its bound (a fraction of a second
+    too: the bound is not rounded to whole seconds) once it has a nest; the shortest nest it
+    reported is laid, whole and checked, and no search is left running. These seven pieces
+    keep sparrow searching for more than 30 s; before, a bound of 0.5 s was rounded up to one
+    second for each of its two phases."""
+    pieces, areas = tapered_pieces()
+    nest = nest_pieces(pieces, 2.5, net_areas=areas, time_limit=0.5, seed=1)
+    assert not nest.finished and nest.time_limit == 0.5
+    assert 0.5 <= nest.search_time < 2.5, nest.search_time  # the process's start included
+    assert sorted(p.index for p in nest.pieces) == list(range(7))
+    placed = [Polygon(p.place(pieces[p.index])) for p in nest.pieces]
+    assert all(not a.intersects(b) for a, b in itertools.combinations(placed, 2))
+    assert max(p.bounds[3] for p in placed) <= 2.5
+    assert nest.length < 0.6 * sum(np.ptp(p[:, 0]) for p in pieces)  # rows side by side
+    assert search_processes() == []
+    with pytest.raises(ValueError, match="must be positive"):
+        nest_pieces(pieces, 2.5, net_areas=areas, time_limit=0.0)
+
+
+def test_a_search_that_fails_says_why(tmp_path, monkeypatch):
+    """A search that reports its failure, or whose process ends without a nest, is an error
+    with the search's own last word, not a nest."""
+    pieces, areas = tapered_pieces(2)
+    failing = tmp_path / "failing.py"
+    failing.write_text(
+        'import json, sys\nsys.stdin.read()\nprint(json.dumps({"kind": "error", '
+        '"message": "strip too narrow"}))\n'
+    )
+    monkeypatch.setattr(nesting, "_WORKER", failing)
+    with pytest.raises(NestError, match="the nesting search failed: strip too narrow"):
+        nest_pieces(pieces, 2.5, net_areas=areas, time_limit=5)
+    crashing = tmp_path / "crashing.py"
+    crashing.write_text("import sys\nsys.stdin.read()\nraise SystemExit('no spyrrow here')\n")
+    monkeypatch.setattr(nesting, "_WORKER", crashing)
+    with pytest.raises(NestError, match="ended without a nest: no spyrrow here"):
+        nest_pieces(pieces, 2.5, net_areas=areas, time_limit=5)
 
 
 def test_a_piece_as_wide_as_the_roll_is_refused_by_the_nest_as_by_the_cut():

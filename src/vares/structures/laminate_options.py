@@ -167,7 +167,8 @@ class LaminateOptions(Options):
     nest_time: float = option(
         10.0,
         "float",
-        "Time for nesting the plies on the roll (seconds).",
+        "Bound on the time for nesting the plies on the roll (seconds); a search that ends "
+        "by itself within it gives the same nest for the same plies.",
         section="laminate",
         positive=True,
     )

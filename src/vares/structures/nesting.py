@@ -8,19 +8,28 @@ bindings ``spyrrow`` (MIT), which bundle it with its collision engine jagua-rs (
 result is checked independently here with shapely: no two pieces overlap, every piece lies
 inside the roll.
 
-The search is bounded by ``time_limit`` seconds and ends earlier by itself when it has stopped
-improving (sparrow's early termination: a number of attempts, not a time). It runs on one
-thread from ``seed``, so a search that ended by itself gives the same placements for the same
-outlines every time, on any machine as fast or slower; one stopped by its time bound ends
-where the time ran out, which depends on the machine's load (``RollNest.finished`` says
-which).
+The search runs in a process of its own (``_nest_search.py``), on one thread from ``seed``;
+sparrow ends each of its two phases by itself when it stops improving (its early termination
+counts failed attempts, not time): the exploration within half of ``time_limit`` seconds at
+most, the compression within the rest. A search that ended by itself, its exploration before its
+share of the time was up and its compression before the bound, gives the same placements for
+the same outlines every time, on any machine (``RollNest.finished``). At the bound the process
+is stopped and the shortest nest the search had reported is taken: where the time ran out
+depends on the machine and its load.
 """
 
 from __future__ import annotations
 
+import json
+import math
+import queue
+import subprocess
+import sys
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -38,11 +47,15 @@ __all__ = [
 #: Clearance the nesting search keeps between pieces and to the roll's edges, relative to the
 #: roll width (the search works in single precision; the clearance makes the result exact).
 _CLEARANCE = 2e-5
-#: Shares of the time bound given to the search's exploration and to its compression.
-_EXPLORATION, _COMPRESSION = 0.5, 0.5
-#: A search counts as ended by itself if it took less than the shorter phase's bound by this
-#: share of it (sparrow checks its clock between moves).
-_MARGIN = 0.05
+#: Share of the time bound the exploration may take at most; the compression may take the rest
+#: (at the default 10 s, the form-found sail's 44 strips at 2.5 m nest in 2,574.7 m of roll so,
+#: 2,577.3 m with the whole bound for the exploration, docs/cutting.md).
+_EXPLORATION = 0.5
+#: Failed attempts in a row after which sparrow's exploration ends by itself (its early
+#: termination, ``DEFAULT_MAX_CONSEQ_FAILS_EXPL``; checked by tests/test_cutting.py).
+_FAILED_ATTEMPTS = 10
+#: The search's own process (module docs).
+_WORKER = Path(__file__).with_name("_nest_search.py")
 
 
 class NestError(RuntimeError):
@@ -126,9 +139,8 @@ def nest_pieces(
     seed: int = 0,
 ) -> RollNest:
     """Lay the cut outlines ``(k_i, 2)`` (warp along +x) on a roll of ``roll_width`` (module
-    docs), ``gap`` apart, searching for ``time_limit`` seconds at most (rounded to whole
-    seconds, at least one) from ``seed``."""
-    import spyrrow
+    docs), ``gap`` apart, searching for ``time_limit`` seconds at most from ``seed`` (the
+    search's first nest is waited for, however long it takes)."""
     from shapely.geometry import Polygon
 
     started = time.perf_counter()
@@ -140,43 +152,36 @@ def nest_pieces(
                 f"piece {index + 1} is {np.ptp(shape[:, 1]):.6g} wide across the warp; a roll "
                 f"of {roll_width:g} takes at most {usable_width(roll_width):.6g}"
             )
-    config_seconds = max(1, round(time_limit))
+    if not time_limit > 0:
+        raise ValueError(f"the nesting search's time bound must be positive; got {time_limit}")
     offsets = [shape.min(axis=0) for shape in shapes]  # sparrow likes pieces near the origin
-    items = [
-        spyrrow.Item(
-            str(index),
-            _search_shape(shape - offset, clearance),
-            demand=1,
-            allowed_orientations=[0.0, 180.0] if allow_turn else [0.0],
-        )
-        for index, (shape, offset) in enumerate(zip(shapes, offsets, strict=True))
-    ]
     # pieces kept a further single-precision step apart; the strip widened by as much at
     # either edge, since the search keeps the pieces' separation to its edges too
     extra = single_precision_step(shapes, roll_width)
-    instance = spyrrow.StripPackingInstance(
-        "roll", strip_height=roll_width - 2 * clearance + 2 * extra, items=items
-    )
-    config = spyrrow.StripPackingConfig(
-        early_termination=True,
-        total_computation_time=None,
-        exploration_time=max(1, round(_EXPLORATION * config_seconds)),
-        compression_time=max(1, round(_COMPRESSION * config_seconds)),
-        min_items_separation=gap + clearance + extra,
-        num_workers=1,
-        seed=seed,
-    )
-    solution, search_time, finished = _search(instance, config, config_seconds)
+    spec = {
+        "shapes": [_search_shape(s - o, clearance) for s, o in zip(shapes, offsets, strict=True)],
+        "orientations": [0.0, 180.0] if allow_turn else [0.0],
+        "height": roll_width - 2 * clearance + 2 * extra,
+        "separation": gap + clearance + extra,
+        "seed": int(seed),
+        # sparrow's phase bounds are whole seconds; the compression's never ends it before the
+        # bound stops the search
+        "exploration_seconds": max(1, round(_EXPLORATION * time_limit)),
+        "compression_seconds": math.ceil(time_limit),
+        "failed_attempts": _FAILED_ATTEMPTS,
+    }
+    placed, search_time, finished = _search(spec, time_limit)
     pieces = []
-    for placed in solution.placed_items:
-        index = int(placed.id)
-        rotation = float(np.round(placed.rotation)) % 360.0
+    for index, angle, *position in placed:
+        rotation = float(np.round(angle)) % 360.0
         moved = NestedPiece(index, rotation, np.zeros(2))
         turned_offset = moved.place(-offsets[index][None])[0]
-        translation = np.array(placed.translation, dtype=float) + turned_offset
+        translation = np.array(position, dtype=float) + turned_offset
         translation += [0.0, clearance - extra]
         pieces.append(NestedPiece(index, rotation, translation))
     pieces.sort(key=lambda p: p.index)
+    if [p.index for p in pieces] != list(range(len(shapes))):
+        raise NestError("the nesting search did not place every piece once")
     placed_shapes = [Polygon(p.place(shapes[p.index])) for p in pieces]
     start = min(s.bounds[0] for s in placed_shapes)
     pieces = [NestedPiece(p.index, p.rotation, p.translation - [start, 0.0]) for p in pieces]
@@ -189,26 +194,79 @@ def nest_pieces(
         pieces,
         float(sum(net_areas)),
         time.perf_counter() - started,
-        float(config_seconds),
+        float(time_limit),
         search_time,
         finished,
     )
 
 
-def _search(instance, config, seconds: float):
-    """The solution, the search's wall time and whether it ended by itself: a phase stopped by
-    its bound ran for that long, so a search that took less than the shorter bound (by
-    ``_MARGIN``) was stopped by neither."""
+def _search(spec: dict, seconds: float) -> tuple[list, float, bool]:
+    """The search's placements ``[index, rotation, x, y]``, its wall time and whether it ended
+    by itself: run in its own process (module docs), stopped ``seconds`` after it started,
+    once it has reported a nest; then the shortest nest it reported is taken."""
     started = time.perf_counter()
+    process = subprocess.Popen(
+        [sys.executable, str(_WORKER)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    lines: queue.Queue = queue.Queue()
+
+    def read(stream, into: list | None = None) -> None:
+        for line in stream:
+            if into is None:
+                lines.put(line)
+            else:
+                into.append(line)
+        if into is None:
+            lines.put(None)
+
+    errors: list[str] = []
+    readers = [
+        threading.Thread(target=read, args=(process.stdout,), daemon=True),
+        threading.Thread(target=read, args=(process.stderr, errors), daemon=True),
+    ]
+    best, finished = None, False
     try:
-        solution = instance.solve(config)
-    except BaseException as exc:  # a panic in the Rust code arrives as a BaseException
-        if isinstance(exc, KeyboardInterrupt | SystemExit):
-            raise
-        raise NestError(f"the nesting search failed: {exc}") from None
+        for reader in readers:
+            reader.start()
+        try:
+            process.stdin.write(json.dumps(spec))
+            process.stdin.close()
+        except BrokenPipeError:  # the process ended at once: its last word is read below
+            pass
+        while True:
+            left = started + seconds - time.perf_counter()
+            try:
+                line = lines.get(timeout=max(left, 0.0) if best is not None else None)
+            except queue.Empty:  # the bound: the search has a nest, take its shortest
+                break
+            if line is None:
+                break
+            record = json.loads(line)
+            if record["kind"] == "error":
+                raise NestError(f"the nesting search failed: {record['message']}")
+            if best is None or record["width"] <= best["width"] or record["kind"] == "final":
+                best = record
+            if record["kind"] == "final":
+                finished = record["explored"]
+                break
+    finally:
+        if process.poll() is None:
+            process.kill()
+        process.wait()
+        for reader in readers:
+            reader.join(1.0)
     elapsed = time.perf_counter() - started
-    shorter = min(config.exploration_time, config.compression_time).total_seconds()
-    return solution, elapsed, elapsed < (1 - _MARGIN) * shorter
+    if best is None:
+        message = "".join(errors).strip().splitlines()
+        raise NestError(
+            "the nesting search ended without a nest"
+            + (f": {message[-1]}" if message else f" (exit status {process.returncode})")
+        )
+    return best["placed"], elapsed, finished
 
 
 def _search_shape(shape: np.ndarray, clearance: float) -> list[tuple[float, float]]:

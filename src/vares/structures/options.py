@@ -141,7 +141,7 @@ class CutOptions(Options):
         10.0,
         "float",
         "Bound on the nesting search's time (seconds); a search that ends by itself within "
-        "half of it gives the same nest for the same input (strips in pairs need no search).",
+        "it gives the same nest for the same input (strips in pairs need no search).",
         section="cut",
         positive=True,
     )
