@@ -265,6 +265,20 @@ def test_a_search_that_fails_says_why(tmp_path, monkeypatch):
         nest_pieces(pieces, 2.5, net_areas=areas, time_limit=5)
 
 
+def test_the_search_runs_in_a_python_interpreter_or_in_a_thread(monkeypatch):
+    """The search's process is started with this Python, or where its executable is an
+    application embedding Python, with the interpreter that application gave multiprocessing;
+    with neither, in a thread (``None``)."""
+    from multiprocessing import spawn
+
+    assert nesting._interpreter() == sys.executable
+    monkeypatch.setattr(sys, "executable", "/opt/cad/bin/Designer.exe")
+    monkeypatch.setattr(spawn, "get_executable", lambda: "/opt/cad/python/bin/python3.11")
+    assert nesting._interpreter() == "/opt/cad/python/bin/python3.11"
+    monkeypatch.setattr(spawn, "get_executable", lambda: "/opt/cad/bin/Designer.exe")
+    assert nesting._interpreter() is None
+
+
 def test_a_piece_as_wide_as_the_roll_is_refused_by_the_nest_as_by_the_cut():
     """``cut`` and the nesting agree on the widest piece (``usable_width``): a piece exactly as
     wide as the roll is refused before the search, one at the usable width is laid."""

@@ -12,7 +12,7 @@ from vares.geometry.cross_cut import cut_across
 from vares.geometry.examples import cylinder160, saddle, tent_roof
 from vares.geometry.flatten import lscm
 from vares.geometry.surface_lines import CuttingError, SurfaceLine, geodesic_lines, triangulated
-from vares.structures import find_seams, split_panels
+from vares.structures import find_seams, nesting, split_panels
 from vares.structures.cutting import cut
 from vares.structures.layout import plan_strips
 from vares.structures.nesting import nest_pieces
@@ -99,7 +99,7 @@ def test_tapered_pieces_with_a_straight_edge_are_laid_in_pairs():
     assert searched.length < 3 * 6.0 * 1.01
 
 
-def test_the_same_pieces_give_the_same_search():
+def test_the_same_pieces_give_the_same_search(monkeypatch):
     """The search runs on one thread from its seed; one that ends by itself (well inside its
     bound) lays every piece at the same place, to the last bit, run after run."""
     pieces, areas = tapered_pieces(2)
@@ -112,6 +112,13 @@ def test_the_same_pieces_give_the_same_search():
     for a, b in zip(first.pieces, second.pieces, strict=True):
         assert np.array_equal(a.translation, b.translation)
     assert first.length == second.length
+    # where no Python process can be started (an application embedding Python), the same
+    # search in a thread of this process: the same nest
+    monkeypatch.setattr(nesting, "_interpreter", lambda: None)
+    threaded = nest_pieces(pieces, 2.5, net_areas=areas, time_limit=60, seed=3)
+    assert threaded.finished
+    for a, b in zip(first.pieces, threaded.pieces, strict=True):
+        assert a.rotation == b.rotation and np.array_equal(a.translation, b.translation)
 
 
 def straightness(panel, warp) -> tuple[float, float]:

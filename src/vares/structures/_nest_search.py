@@ -1,7 +1,8 @@
 """The nesting search in a process of its own, so that its time bound can stop it.
 
-Run as a script by :func:`vares.structures.nesting.nest_pieces` (not imported: the process
-loads spyrrow alone, not vares). Reads the instance as one JSON object from stdin; writes one
+Run as a script by :func:`vares.structures.nesting.nest_pieces` (the process loads spyrrow
+alone, not vares); :func:`run` is the search itself, which that function runs in a thread where
+it cannot start a Python process. Reads the instance as one JSON object from stdin; writes one
 JSON line to stdout for every feasible nest the search reports on its way (``"feasible"``), then
 the search's own result (``"final"``), or ``"error"`` with the message of a search that failed.
 Each line has the nest's ``width`` (its length along the roll) and its ``placed`` pieces as
@@ -18,7 +19,7 @@ import threading
 import time
 
 
-def _line(kind: str, solution=None, message: str = "", **more) -> None:
+def _record(kind: str, solution=None, message: str = "", **more) -> dict:
     record: dict = {"kind": kind, **more}
     if solution is not None:
         record["width"] = float(solution.width)
@@ -28,14 +29,13 @@ def _line(kind: str, solution=None, message: str = "", **more) -> None:
         ]
     if message:
         record["message"] = message
-    sys.stdout.write(json.dumps(record) + "\n")
-    sys.stdout.flush()
+    return record
 
 
-def main() -> None:
+def run(spec: dict, emit) -> None:
+    """The search of ``spec`` (module docs), each record given to ``emit`` as it comes."""
     import spyrrow
 
-    spec = json.load(sys.stdin)
     items = [
         spyrrow.Item(
             str(index),
@@ -77,18 +77,26 @@ def main() -> None:
                 last_failure = time.monotonic() if failed == spec["failed_attempts"] else None
             elif kind in (Report.ExplFeas, Report.CmprFeas):
                 failed = 0 if kind == Report.ExplFeas else failed
-                _line("feasible", solution)
+                emit(_record("feasible", solution))
         if not thread.is_alive():
             break
     if "error" in outcome:
-        _line("error", message=outcome["error"])
+        emit(_record("error", message=outcome["error"]))
         return
     explored = (
         failed == spec["failed_attempts"]
         and last_failure is not None
         and last_failure < started + spec["exploration_seconds"]
     )
-    _line("final", outcome["solution"], explored=explored)
+    emit(_record("final", outcome["solution"], explored=explored))
+
+
+def main() -> None:
+    def emit(record: dict) -> None:
+        sys.stdout.write(json.dumps(record) + "\n")
+        sys.stdout.flush()
+
+    run(json.load(sys.stdin), emit)
 
 
 if __name__ == "__main__":

@@ -22,12 +22,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import queue
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -203,32 +204,49 @@ def nest_pieces(
 def _search(spec: dict, seconds: float) -> tuple[list, float, bool]:
     """The search's placements ``[index, rotation, x, y]``, its wall time and whether it ended
     by itself: run in its own process (module docs), stopped ``seconds`` after it started,
-    once it has reported a nest; then the shortest nest it reported is taken."""
+    once it has reported a nest; then the shortest nest it reported is taken. Where no Python
+    process can be started (an application that embeds Python, whose executable is not an
+    interpreter, and has not told :mod:`multiprocessing` where one is), the same search runs in
+    a thread of this process: the same nest, but at the bound it is left to run out its own
+    clocks (at most one and a half times the bound) in the background."""
     started = time.perf_counter()
-    process = subprocess.Popen(
-        [sys.executable, str(_WORKER)],
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    lines: queue.Queue = queue.Queue()
-
-    def read(stream, into: list | None = None) -> None:
-        for line in stream:
-            if into is None:
-                lines.put(line)
-            else:
-                into.append(line)
-        if into is None:
-            lines.put(None)
-
+    records: queue.Queue = queue.Queue()
     errors: list[str] = []
+    interpreter = _interpreter()
+    if interpreter is None:
+        from ._nest_search import run
+
+        threading.Thread(target=_in_thread, args=(run, spec, records), daemon=True).start()
+        return _first_records(records, started, seconds, errors)
+    try:
+        process = subprocess.Popen(
+            [interpreter, str(_WORKER)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+    except OSError as exc:
+        raise NestError(f"the nesting search could not start ({interpreter}): {exc}") from None
+
+    def read(stream, searched: bool) -> None:
+        """The search's records from its stdout (``searched``), anything else into ``errors``."""
+        for line in stream:
+            try:
+                record = json.loads(line) if searched else None
+            except ValueError:  # not the search's: a word for the error message
+                record = None
+            if record is None:
+                errors.append(line)
+            else:
+                records.put(record)
+        if searched:
+            records.put(None)
+
     readers = [
-        threading.Thread(target=read, args=(process.stdout,), daemon=True),
-        threading.Thread(target=read, args=(process.stderr, errors), daemon=True),
+        threading.Thread(target=read, args=(process.stdout, True), daemon=True),
+        threading.Thread(target=read, args=(process.stderr, False), daemon=True),
     ]
-    best, finished = None, False
     try:
         for reader in readers:
             reader.start()
@@ -237,34 +255,74 @@ def _search(spec: dict, seconds: float) -> tuple[list, float, bool]:
             process.stdin.close()
         except BrokenPipeError:  # the process ended at once: its last word is read below
             pass
-        while True:
-            left = started + seconds - time.perf_counter()
-            try:
-                line = lines.get(timeout=max(left, 0.0) if best is not None else None)
-            except queue.Empty:  # the bound: the search has a nest, take its shortest
-                break
-            if line is None:
-                break
-            record = json.loads(line)
-            if record["kind"] == "error":
-                raise NestError(f"the nesting search failed: {record['message']}")
-            if best is None or record["width"] <= best["width"] or record["kind"] == "final":
-                best = record
-            if record["kind"] == "final":
-                finished = record["explored"]
-                break
+
+        def ended() -> int:  # the process's exit status, its stderr read to the end
+            status = process.wait()
+            readers[1].join(5.0)
+            return status
+
+        return _first_records(records, started, seconds, errors, ended)
     finally:
         if process.poll() is None:
             process.kill()
         process.wait()
         for reader in readers:
             reader.join(1.0)
+
+
+def _interpreter() -> str | None:
+    """The Python interpreter to run the search with: this one, or where its executable is an
+    application embedding Python, the one it told :mod:`multiprocessing` of; ``None`` where
+    neither is a Python interpreter."""
+    from multiprocessing import spawn
+
+    for executable in (sys.executable, spawn.get_executable()):
+        if executable and Path(os.fsdecode(executable)).name.lower().startswith("python"):
+            return os.fsdecode(executable)
+    return None
+
+
+def _in_thread(run, spec: dict, records: queue.Queue) -> None:
+    """:func:`._nest_search.run` in a thread, its records into ``records``, ``None`` last."""
+    try:
+        run(spec, records.put)
+    except BaseException as exc:  # reported to the caller, which waits on the records
+        records.put({"kind": "error", "message": str(exc) or type(exc).__name__})
+    records.put(None)
+
+
+def _first_records(
+    records: queue.Queue,
+    started: float,
+    seconds: float,
+    errors: list[str],
+    ended: Callable[[], int] | None = None,
+) -> tuple[list, float, bool]:
+    """:func:`_search`'s result from the search's records (``None`` after the last), read
+    until the search's own end or ``seconds`` after ``started`` once it has a nest; ``errors``:
+    what the search's process wrote to stderr, ``ended()`` its exit status once it has ended."""
+    best, finished = None, False
+    while True:
+        left = started + seconds - time.perf_counter()
+        try:
+            record = records.get(timeout=max(left, 0.0) if best is not None else None)
+        except queue.Empty:  # the bound: the search has a nest, take its shortest
+            break
+        if record is None:
+            break
+        if record["kind"] == "error":
+            raise NestError(f"the nesting search failed: {record['message']}")
+        if best is None or record["width"] <= best["width"] or record["kind"] == "final":
+            best = record
+        if record["kind"] == "final":
+            finished = record["explored"]
+            break
     elapsed = time.perf_counter() - started
     if best is None:
+        status = "" if ended is None else f" (exit status {ended()})"
         message = "".join(errors).strip().splitlines()
         raise NestError(
-            "the nesting search ended without a nest"
-            + (f": {message[-1]}" if message else f" (exit status {process.returncode})")
+            "the nesting search ended without a nest" + (f": {message[-1]}" if message else status)
         )
     return best["placed"], elapsed, finished
 
