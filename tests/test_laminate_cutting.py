@@ -316,6 +316,10 @@ def test_job_writes_cutter_files_and_nest(job_run):
     net = sum(b["net_area"] for b in summary["blanks"])
     assert nest["yield"] == pytest.approx(net / (nest["roll_width"] * nest["length"]), rel=1e-12)
     assert nest["net_area"] == pytest.approx(net, rel=1e-12)
+    # how the search ended, as for a cut: its bound, seed, time and whether it ended by itself
+    assert nest["time_limit"] == done.result.laminate.options.nest_time and nest["seed"] == 0
+    assert 0 < nest["search_seconds"] <= nest["time_limit"] + 2.0
+    assert nest["finished"] == done.nest.finished and done.nest.method == "search"
     blank = summary["blanks"][0]
     assert blank["net_mass"] == pytest.approx(200.0 * blank["net_area"] * 1e-6, rel=1e-12)
     assert blank["producibility"]["ok_fraction"] == 1.0
@@ -342,6 +346,8 @@ def test_ply_book_opens_in_chromium_with_a_section_per_ply(job_run, tmp_path):
     assert dom.split('id="total-thickness"')[1].startswith(">Total thickness: 0.8 mm.")
     nest = dom.split('id="nest"')[1].split("</table>")[0]
     assert f"{100 * done.nest.yield_:.1f} %" in nest
+    said = "stopped by its time bound" if not done.nest.finished else "ended by itself in"
+    assert said in nest
     assert dom.count("data:image/png;base64,") == 3 * 4 + 1
     assert 'id="pairs-warp_compressed_fraction"' in dom
     screenshot = tmp_path / "book.png"
@@ -359,6 +365,8 @@ def test_cli_prints_the_plies_and_the_yield(job_run, tmp_path):
     assert done.exit_code == 0, done.stderr
     summary = json.loads((tmp_path / "cli" / "laminate.json").read_text())
     assert f"yield {100 * summary['nest']['yield']:.1f} %" in done.stderr
+    stopped = "the nesting search was stopped by its time bound" in done.stderr
+    assert stopped == (not summary["nest"]["finished"])
     assert "plies as cut" in done.stderr
     again = run("laminate", folder / "job.toml", "-o", tmp_path / "cli", "-q")
     assert again.exit_code == 2 and "--force" in error_line(again)

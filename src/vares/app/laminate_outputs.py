@@ -135,6 +135,10 @@ class LaminateRun:
                 "net_area": self.nest.net_area,
                 "yield": self.nest.yield_,
                 "seconds": self.nest.elapsed,
+                "search_seconds": self.nest.search_time,
+                "time_limit": self.nest.time_limit,
+                "seed": self.nest.seed,
+                "finished": self.nest.finished,
                 "pieces": [
                     {
                         "ply": self.blanks[p.index].name,

@@ -147,11 +147,8 @@ class CutResult:
                 f"the strip without a partner is cut across at half its length: {a} and {b} "
                 "lie side by side, the cross seam matched like every seam"
             )
-        if self.nest is not None and not self.nest.finished:
-            notes.append(
-                f"the nesting search was stopped by its time bound ({self.nest.time_limit:g} s): "
-                "a longer one (nest_time) may nest shorter, and another run may nest otherwise"
-            )
+        if self.nest is not None and self.nest.stopped:
+            notes.append(self.nest.stopped)
         return notes
 
 

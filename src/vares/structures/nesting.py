@@ -84,7 +84,7 @@ class RollNest:
     """Pieces on one roll: their placements, the length of roll used (from x = 0 to the end of
     the last piece), the net area (the patterns inside their seam lines) and the yield, net area
     / (roll width × length); the search's bound and time and whether it ended by itself (module
-    docs), and the ``method``: ``search`` or ``pairs`` (:mod:`.pair_nest`)."""
+    docs), the ``method``: ``search`` or ``pairs`` (:mod:`.pair_nest`), and the search's seed."""
 
     roll_width: float
     length: float
@@ -95,6 +95,7 @@ class RollNest:
     search_time: float = 0.0
     finished: bool = False
     method: str = "search"
+    seed: int = 0
 
     @property
     def yield_(self) -> float:
@@ -104,6 +105,17 @@ class RollNest:
     def waste(self) -> float:
         """Fraction of the roll used that is cut away: 1 − yield."""
         return 1.0 - self.yield_
+
+    @property
+    def stopped(self) -> str | None:
+        """What a nest the time bound stopped the search for means (``None`` for one the
+        search ended by itself, and for one made without a search)."""
+        if self.method != "search" or self.finished:
+            return None
+        return (
+            f"the nesting search was stopped by its time bound ({self.time_limit:g} s): a "
+            "longer one (nest_time) may nest shorter, and another run may nest otherwise"
+        )
 
 
 def clearance_of(roll_width: float) -> float:
@@ -198,6 +210,7 @@ def nest_pieces(
         float(time_limit),
         search_time,
         finished,
+        seed=int(seed),
     )
 
 

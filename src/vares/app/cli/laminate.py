@@ -137,5 +137,7 @@ def _show_cutting(run) -> None:
             f"{nest.length:.6g} {units} long, yield {100 * nest.yield_:.1f} % "
             f"({nest.elapsed:.1f} s)"
         )
+        if nest.stopped:
+            console.print(f"  {nest.stopped}")
     elif run.nest_error is not None:
         console.print(f"not nested: {run.nest_error}")
