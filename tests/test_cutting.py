@@ -279,6 +279,21 @@ def test_the_search_runs_in_a_python_interpreter_or_in_a_thread(monkeypatch):
     assert nesting._interpreter() is None
 
 
+def test_a_nest_says_how_it_was_made():
+    """Reports and commands say whether a nest is the same for the same input: made in pairs
+    (no search), searched to the search's own end, or stopped by the bound."""
+    from vares.structures.nesting import RollNest
+
+    pairs = RollNest(2.5, 10.0, [], 20.0, 0.1, 0.0, 0.0, True, "pairs")
+    ended = RollNest(2.5, 10.0, [], 20.0, 4.2, 10.0, 4.04, True, seed=3)
+    stopped = RollNest(2.5, 10.0, [], 20.0, 10.0, 10.0, 10.0, False)
+    assert pairs.stopped is None and "no search: the same nest on every machine" in pairs.how
+    assert ended.stopped is None
+    assert ended.how == "the search ended by itself in 4.0 s: the same nest for the same input"
+    assert stopped.how == stopped.stopped
+    assert stopped.stopped.startswith("the nesting search was stopped by its time bound (10 s)")
+
+
 def test_a_piece_as_wide_as_the_roll_is_refused_by_the_nest_as_by_the_cut():
     """``cut`` and the nesting agree on the widest piece (``usable_width``): a piece exactly as
     wide as the roll is refused before the search, one at the usable width is laid."""

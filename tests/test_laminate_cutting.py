@@ -346,7 +346,7 @@ def test_ply_book_opens_in_chromium_with_a_section_per_ply(job_run, tmp_path):
     assert dom.split('id="total-thickness"')[1].startswith(">Total thickness: 0.8 mm.")
     nest = dom.split('id="nest"')[1].split("</table>")[0]
     assert f"{100 * done.nest.yield_:.1f} %" in nest
-    said = "stopped by its time bound" if not done.nest.finished else "ended by itself in"
+    said = "stopped by its time bound" if not done.nest.finished else "search ended by itself in"
     assert said in nest
     assert dom.count("data:image/png;base64,") == 3 * 4 + 1
     assert 'id="pairs-warp_compressed_fraction"' in dom

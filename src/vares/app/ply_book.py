@@ -220,11 +220,7 @@ def _nest_section(nest: RollNest | None, blanks, units: str) -> list[str]:
         ("length used", f"{number(nest.length)} {units}"),
         ("net area of the plies", f"{number(nest.net_area)} {units}²"),
         ("yield (net area / roll used)", f"{100 * nest.yield_:.1f} %"),
-        (
-            "search",
-            nest.stopped
-            or f"ended by itself in {nest.search_time:.1f} s: the same nest for the same plies",
-        ),
+        ("made", nest.how),
     ]
     drawings = []
     for piece in nest.pieces:

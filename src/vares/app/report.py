@@ -382,6 +382,7 @@ def _cut_section(outcome: JobOutcome) -> list[str]:
         key += [
             ("roll length used", f"{number(nest.length)} {units}"),
             ("yield", f"{100 * nest.yield_:.1f} % (waste {100 * nest.waste:.1f} %)"),
+            ("nest made", nest.how),
         ]
     parts = ["<h2>Cutting and nesting</h2>", table(key, ident="cut-figures")]
     lines = plot_cut_lines(plan.cut.mesh, plan.cut.panel_ids, plan.cut.lines, dpi=REPORT_DPI)

@@ -107,6 +107,18 @@ class RollNest:
         return 1.0 - self.yield_
 
     @property
+    def how(self) -> str:
+        """How the nest was made, in a few words (reports)."""
+        if self.method != "search":
+            return f"laid in {self.method}, no search: the same nest on every machine"
+        if self.finished:
+            return (
+                f"the search ended by itself in {self.search_time:.1f} s: the same nest for the "
+                "same input"
+            )
+        return self.stopped
+
+    @property
     def stopped(self) -> str | None:
         """What a nest the time bound stopped the search for means (``None`` for one the
         search ended by itself, and for one made without a search)."""
