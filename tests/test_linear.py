@@ -13,7 +13,7 @@ import scipy.sparse as sp
 import vares
 from vares import examples
 from vares.materials import OrthotropicStVenantKirchhoff
-from vares.solver import linear
+from vares.solver import linear, pardiso
 from vares.solver.linear import SingularMatrixError, available_solvers, get_solver
 from vares.structures import matching
 
@@ -35,7 +35,7 @@ def test_upper_triangle_map_adds_missing_diagonal_entries():
     matrix = _saddle_point_matrix()
     matrix.sort_indices()
     assert matrix.diagonal()[-1] == 0.0 and matrix[-1, -1] == 0.0
-    index, indptr, indices = linear._upper_triangle_map(matrix)
+    index, indptr, indices = pardiso._upper_triangle_map(matrix)
     data = np.append(matrix.data, 0.0)[index]
     upper = sp.csr_matrix((data, indices, indptr), shape=matrix.shape)
     np.testing.assert_array_equal(upper.toarray(), np.triu(matrix.toarray()))
@@ -51,7 +51,7 @@ def test_upper_triangle_map_of_a_matrix_with_its_whole_diagonal():
     matrix = _saddle_point_matrix() + sp.identity(_saddle_point_matrix().shape[0]) * 1e-3
     matrix = sp.csr_matrix(matrix)
     matrix.sort_indices()
-    index, indptr, indices = linear._upper_triangle_map(matrix)
+    index, indptr, indices = pardiso._upper_triangle_map(matrix)
     assert np.all(index >= 0) and np.all(np.diff(index) > 0)
     upper = sp.csr_matrix((matrix.data[index], indices, indptr), shape=matrix.shape)
     np.testing.assert_array_equal(upper.toarray(), np.triu(matrix.toarray()))
@@ -65,7 +65,7 @@ def test_upper_triangle_map_of_a_matrix_with_its_whole_diagonal():
             shuffled.data[a:b][::-1],
         )
     shuffled.has_sorted_indices = False
-    index, indptr, indices = linear._upper_triangle_map(shuffled)
+    index, indptr, indices = pardiso._upper_triangle_map(shuffled)
     assert all(np.all(np.diff(indices[a:b]) > 0) for a, b in itertools.pairwise(indptr))
     upper = sp.csr_matrix((shuffled.data[index], indices, indptr), shape=matrix.shape)
     np.testing.assert_array_equal(upper.toarray(), np.triu(matrix.toarray()))
@@ -271,11 +271,11 @@ def test_pardiso_maps_a_sparsity_pattern_to_its_upper_triangle_once(monkeypatch)
     optimiser's states) reuse the upper-triangle map of the last pattern; another pattern is
     mapped afresh, and every solve is right."""
     calls = []
-    original = linear._upper_triangle_map
+    original = pardiso._upper_triangle_map
     monkeypatch.setattr(
-        linear, "_upper_triangle_map", lambda matrix: (calls.append(1), original(matrix))[1]
+        pardiso, "_upper_triangle_map", lambda matrix: (calls.append(1), original(matrix))[1]
     )
-    monkeypatch.setattr(linear._PARDISO_STATE, "upper", None)
+    monkeypatch.setattr(pardiso._PARDISO_STATE, "upper", None)
     rng = np.random.default_rng(3)
     a = sp.random(40, 40, density=0.2, random_state=rng)
     first = (a @ a.T + 40 * sp.identity(40)).tocsr()

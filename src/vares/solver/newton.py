@@ -25,9 +25,10 @@ from ..materials import InadmissibleState
 from ..mechanics.assembly import Assembler
 from .failure import Failure, describe_cells
 from .line_search import LineSearch
-from .linear import LinearSolver, SingularMatrixError
+from .linear import LinearSolver
 from .result import IterationRecord, StepRecord
 from .reuse import ETA_MAX, ReusingSolver, forcing_term
+from .steps import Damping, plain_step
 from .turning import TurningSearch, TurnState, turning_minimum
 
 __all__ = [
@@ -229,23 +230,6 @@ class NewtonContext:
         return x
 
 
-@dataclass
-class _Damping:
-    """State of the damped iteration: the coefficient ``c`` and how fast it grows on rejection."""
-
-    factor: float
-    c: float | None = None
-    growth: float = 2.0
-
-    def cap(self, matrix: sp.csr_matrix, residual: float, initial_residual: float) -> None:
-        scale = self.factor * float(np.mean(np.abs(matrix.diagonal())))
-        cap = scale * min(1.0, residual / initial_residual) if initial_residual > 0 else scale
-        self.c = cap if self.c is None else min(self.c, cap)
-
-    def reject(self) -> None:
-        self.c, self.growth = self.c * self.growth, 2.0 * self.growth
-
-
 def newton(
     problem,
     coordinates: np.ndarray,
@@ -279,7 +263,7 @@ def newton(
     """
     x = coordinates.copy()
     initial_residual = None
-    state = _Damping(damping)
+    damping_state = Damping(damping)
     step_length, tangent = 0.0, ""
     residuals: list[float] = []
     step_lengths: list[float] = []
@@ -298,65 +282,81 @@ def newton(
         initial_residual = residual if initial_residual is None else initial_residual
         residuals.append(residual / ctx.force_scale)
         step_lengths.append(step_length)
-        converged = residual <= ctx.residual_tolerance or at_round_off(
-            residuals[floor_from:], step_lengths[floor_from:], ctx.round_off_regime
+        converged, floor_from = _converged(
+            x, ctx, evaluation, residual_vector, residual, residuals, step_lengths, floor_from
         )
-        if converged and ctx.accepts is not None:
-            converged = ctx.accepts(x)
-        if converged and ctx.turning:  # a stationary rotation, or a minimum?
-            exact = ctx.assembler.matrix(evaluation.hessians)
-            converged = turning_minimum(x, ctx, exact, residual_vector)
-            if not converged:  # the residuals so far say nothing of the round-off floor
-                floor_from = len(residuals)
-        # far from the solution (by the residual) the projected tangent, near it the exact one
-        projected = (
-            method == "line-search"
-            and not ctx.turning  # the exact tangent first, whatever the residual
-            and not converged
-            and residual >= ctx.exact_tangent_below * ctx.force_scale
+        hessians, projected = _tangent(
+            problem, ctx, evaluation, method, converged, residual, step_length
         )
-        hessians = problem.projected_hessians(evaluation) if projected else evaluation.hessians
-        if projected and ctx.absolute_after_short_steps and step_length < 1.0:
-            hessians = absolute_hessians(hessians, evaluation.hessians)
         matrix = None if converged else ctx.assembler.matrix(hessians)
         if method == "damped" and matrix is not None:
-            state.cap(matrix, residual, initial_residual)
+            damping_state.cap(matrix, residual, initial_residual)
         record = (strategy, step, tau, iteration, residual, residual / ctx.force_scale)
-        ctx.record(
-            IterationRecord(*record, evaluation.energy, state.c or 0.0, step_length, tangent)
-        )
+        c = damping_state.c or 0.0
+        ctx.record(IterationRecord(*record, evaluation.energy, c, step_length, tangent))
         if _ends(ctx, x, evaluation.energy, converged, iteration, method, residuals):
             return x
         eta = forcing_term(
             residuals, ctx.residual_tolerance / ctx.force_scale, ctx.loosest_forcing
         )  # relative residuals: the same ratios
-        if method == "full":
-            x, step_length, tangent = _full_step(problem, x, ctx, matrix, residual_vector, eta)
-            evaluation = None
-        elif method == "bounded":
-            x, step_length, tangent = _bounded_step(problem, x, ctx, matrix, residual_vector)
-            evaluation = None
-        elif method == "damped":
-            x, step_length, tangent = _damped_step(
-                problem, x, ctx, matrix, residual_vector, evaluation.energy, state
+        if method != "line-search":
+            energy = evaluation.energy
+            x, step_length, tangent = plain_step(
+                method, problem, x, ctx, matrix, residual_vector, eta, energy, damping_state
             )
             evaluation = None
+            continue
+        if ctx.turning:
+            search = TurningSearch(problem, x, ctx, evaluation, matrix, residual_vector, turn)
         else:
-            if ctx.turning:
-                search = TurningSearch(problem, x, ctx, evaluation, matrix, residual_vector, turn)
-            else:
-                search = LineSearch(
-                    problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
-                )
-            # the search owns the tangent now: it lets go of it before evaluating a trial point
-            del evaluation, matrix, hessians
-            x, step_length, tangent, evaluation = search.step()
-            squeezed = squeezed + 1 if _held_back(search, step_length, step_lengths) else 0
-            if squeezed >= SQUEEZED_ITERATIONS:
-                raise Failure(
-                    ctx.squeezed.format(cells=describe_cells(search.bounded_by)), x, folding=True
-                )
+            search = LineSearch(
+                problem, x, ctx, evaluation, matrix, residual_vector, projected, eta
+            )
+        # the search owns the tangent now: it lets go of it before evaluating a trial point
+        evaluation = matrix = hessians = None
+        x, step_length, tangent, evaluation = search.step()
+        squeezed = squeezed + 1 if _held_back(search, step_length, step_lengths) else 0
+        if squeezed >= SQUEEZED_ITERATIONS:
+            raise Failure(
+                ctx.squeezed.format(cells=describe_cells(search.bounded_by)), x, folding=True
+            )
     raise AssertionError("unreachable")
+
+
+def _converged(x, ctx, evaluation, residual_vector, residual, residuals, step_lengths, floor_from):
+    """Whether the iteration at ``x`` (its ``residual``; the relative ones so far) has converged,
+    and from which residual on the round-off floor is looked for: the tolerance or the floor
+    (:func:`at_round_off`), the objective's own condition (``ctx.accepts``), and for a pattern
+    free to turn a minimum, not a stationary rotation (where it is not, the residuals so far
+    say nothing of the floor)."""
+    converged = residual <= ctx.residual_tolerance or at_round_off(
+        residuals[floor_from:], step_lengths[floor_from:], ctx.round_off_regime
+    )
+    if converged and ctx.accepts is not None:
+        converged = ctx.accepts(x)
+    if converged and ctx.turning:  # a stationary rotation, or a minimum?
+        exact = ctx.assembler.matrix(evaluation.hessians)
+        converged = turning_minimum(x, ctx, exact, residual_vector)
+        if not converged:
+            floor_from = len(residuals)
+    return converged, floor_from
+
+
+def _tangent(problem, ctx, evaluation, method, converged, residual, step_length):
+    """The per-block Hessians of the next step's tangent and whether they are projected: far
+    from the solution (by the relative residual) the projected ones for a line search, with
+    the absolute values of the exact eigenvalues after a shortened step where the context asks
+    for them; near it, and for the other methods, the exact ones."""
+    projected = (
+        method == "line-search"
+        and not ctx.turning  # the exact tangent first, whatever the residual
+        and not converged
+        and residual >= ctx.exact_tangent_below * ctx.force_scale
+    )
+    hessians = problem.projected_hessians(evaluation) if projected else evaluation.hessians
+    if projected and ctx.absolute_after_short_steps and step_length < 1.0:
+        hessians = absolute_hessians(hessians, evaluation.hessians)
+    return hessians, projected
 
 
 def absolute_hessians(projected: list, exact: list) -> list:
@@ -393,55 +393,6 @@ def _stalled(residuals: list[float], window: int | None) -> bool:
     if window is None or len(residuals) <= window:
         return False
     return min(residuals[-window:]) > 0.5 * min(residuals[:-window])
-
-
-def _full_step(problem, x, ctx, matrix, residual_vector, eta):
-    """A plain (inexact) Newton step; one that inverts a cell ends the iteration."""
-    try:
-        delta = ctx.step(matrix, -residual_vector, eta)
-    except SingularMatrixError as exc:
-        raise Failure(f"singular tangent ({exc})", x) from exc
-    trial = x.copy()
-    trial.ravel()[ctx.assembler.free] += delta
-    inverted = problem.inverted_cells(trial)
-    if inverted.size:
-        raise Failure(f"inverted elements: {describe_cells(inverted)}", x)
-    return trial, 1.0, "exact"
-
-
-def _bounded_step(problem, x, ctx, matrix, residual_vector):
-    """An exact Newton step, shortened to 0.9 of the longest that keeps every cell admissible
-    (no line search: the objective's value need not fall, as a Lagrangian's at a saddle)."""
-    try:
-        delta = ctx.step(matrix, -residual_vector)
-    except SingularMatrixError as exc:
-        raise Failure(f"singular tangent ({exc})", x) from exc
-    full = np.zeros_like(x)
-    full.ravel()[ctx.assembler.free] = delta
-    alpha = min(1.0, 0.9 * problem.admissible_step(x, full))
-    return x + alpha * full, alpha, "exact"
-
-
-def _damped_step(problem, x, ctx, matrix, residual_vector, energy, state: _Damping):
-    """A Levenberg–Marquardt step: ``c`` grows until the step lowers the energy."""
-    identity = sp.identity(ctx.assembler.num_free, format="csr")
-    for _attempt in range(60):
-        try:
-            delta = ctx.step(matrix + state.c * identity, -residual_vector)
-        except SingularMatrixError:
-            state.reject()
-            continue
-        trial = x.copy()
-        trial.ravel()[ctx.assembler.free] += delta
-        predicted = -(residual_vector @ delta + 0.5 * delta @ (matrix @ delta))
-        actual = energy - problem.energy(trial)
-        if predicted > 0 and actual >= -ctx.energy_noise:
-            gain = actual / predicted
-            state.c *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
-            state.growth = 2.0
-            return trial, 1.0, "damped"
-        state.reject()
-    raise Failure("damping could not find an admissible step", x)
 
 
 #: After this many iterations in a row whose steps shrink (each below a tenth, each less than

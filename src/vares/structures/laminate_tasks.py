@@ -67,7 +67,7 @@ def drape_task(task: dict[str, Any]) -> dict[str, Any]:
     angle and the lines), and the kinematic net beside it (its failure is reported, not raised;
     a spliced ply's pieces each get one too). Plies may be draped in several threads of one
     process at once (a Dask worker's threads): each thread solves with its own linear solver
-    (:class:`vares.solver.linear.PardisoState`)."""
+    (:class:`vares.solver.pardiso.PardisoState`)."""
     return _drape(task)
 
 
