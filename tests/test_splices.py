@@ -185,11 +185,11 @@ def test_darts_left_beyond_the_locking_angle_on_negative_curvature_advise_a_spli
     assert "negatively curved" in darts_verdict(darted) and "--splice-lines" in darts_verdict(
         darted
     )
-    from vares.app.ply_book import _curvature_advice  # the ply book's line for a laminate
+    from vares.app.ply_sections import curvature_advice  # the ply book's line for a laminate
 
-    assert "negatively curved" in _curvature_advice(darted)
+    assert "negatively curved" in curvature_advice(darted)
     relaxed = DartedPattern(ply.before, None, None, 60.0)  # below a 60° locking angle already
-    assert relaxed.relieved and not relaxed.needs_splices and not _curvature_advice(relaxed)
+    assert relaxed.relieved and not relaxed.needs_splices and not curvature_advice(relaxed)
     assert relaxed.summary()["over_locking_curvature"] is None
 
 
