@@ -11,14 +11,7 @@ import vares
 from vares.analysis import Pattern, erect, erection_residuals
 from vares.analysis.erection_model import patterns_of
 from vares.analysis.erection_optimum import optimise_for_erection, optimised_results
-from vares.analysis.erection_residuals import (
-    PatternLayout,
-    ResidualModel,
-    erected_rms,
-    moved,
-    seam_edges,
-    stiffness_preconditioner,
-)
+from vares.analysis.erection_residuals import ResidualModel, erected_rms, stiffness_preconditioner
 from vares.analysis.erection_sensitivity import (
     block_derivatives,
     block_forces,
@@ -28,6 +21,7 @@ from vares.analysis.erection_sensitivity import (
     yarn_force,
     yarn_force_gradients,
 )
+from vares.analysis.pattern_seams import PatternLayout, moved, seam_edges
 from vares.geometry.elements import ELEMENTS
 from vares.materials import NeoHooke
 from vares.mechanics.erection import ErectionProblem, membrane_block
@@ -347,6 +341,7 @@ def test_the_preconditioned_step_is_the_same_step():
     optimiser's limit) it lowers the damped objective ``|J Δ + r|² + μ |Δ|²`` further than 15
     plain iterations do (the 1,568-triangle PES/PVC hypar of the benchmark)."""
     from vares.analysis import erection_optimum as optimum
+    from vares.analysis import optimum_steps as steps
 
     mesh = vares.examples.hypar(size=10.0, rise=0.06, n=28)
     solved = vares.solve(mesh, PES, prestress=(2.0, 1.5), warp_direction=(1.0, 0.0, 0.0))
@@ -356,22 +351,22 @@ def test_the_preconditioned_step_is_the_same_step():
     seams = seam_edges(patterns, start, layout)
     at = ResidualModel(patterns, start, layout, seams, (1.0, 0.01), 0.1, None, None)
     op = at.operator()
-    mu = optimum.INITIAL_DAMPING * optimum._norm_squared(op)
+    mu = optimum.INITIAL_DAMPING * steps.norm_squared(op)
     preconditioner = stiffness_preconditioner(patterns, PES, 1.0)
 
     def damped(step):
         return float(np.sum((at.residual + op.matvec(step)) ** 2) + mu * step @ step)
 
-    assert optimum.LSQR_LIMIT == 15
-    short, _ = optimum._lsqr(op, at.residual, mu, preconditioner)
-    short_plain, _ = optimum._lsqr(op, at.residual, mu)
-    limit, tolerance = optimum.LSQR_LIMIT, optimum.LSQR_TOLERANCE
+    assert steps.LSQR_LIMIT == 15
+    short, _ = steps.lsqr_step(op, at.residual, mu, preconditioner)
+    short_plain, _ = steps.lsqr_step(op, at.residual, mu)
+    limit, tolerance = steps.LSQR_LIMIT, steps.LSQR_TOLERANCE
     try:
-        optimum.LSQR_LIMIT, optimum.LSQR_TOLERANCE = 3000, 1e-12
-        plain, _ = optimum._lsqr(op, at.residual, mu)
-        tight, _ = optimum._lsqr(op, at.residual, mu, preconditioner)
+        steps.LSQR_LIMIT, steps.LSQR_TOLERANCE = 3000, 1e-12
+        plain, _ = steps.lsqr_step(op, at.residual, mu)
+        tight, _ = steps.lsqr_step(op, at.residual, mu, preconditioner)
     finally:
-        optimum.LSQR_LIMIT, optimum.LSQR_TOLERANCE = limit, tolerance
+        steps.LSQR_LIMIT, steps.LSQR_TOLERANCE = limit, tolerance
     assert np.linalg.norm(tight - plain) < 1e-6 * np.linalg.norm(plain)
     least = damped(plain)
     assert damped(short) - least < 0.5 * (damped(short_plain) - least)
@@ -457,8 +452,8 @@ def test_nodes_held_at_the_bound_keep_their_linearised_deviation():
     and a preconditioned LSQR step solved with nodes held (:class:`HeldNodes`) changes their
     linearised normal deviations by nothing (1e-9 of the step's largest change) while it still
     lowers the damped objective."""
-    from vares.analysis import erection_optimum as optimum
     from vares.analysis.erection_bound import HeldNodes
+    from vares.analysis.optimum_steps import lsqr_step
 
     solved = _taut_hypar()
     patterns = patterns_of(solved)
@@ -475,8 +470,8 @@ def test_nodes_held_at_the_bound_keep_their_linearised_deviation():
     preconditioner = stiffness_preconditioner(patterns, solved.material, 1.0)
     mu = 1e-3 * float(np.linalg.norm(at.rmatvec(at.residual)))
     held = HeldNodes(gradients, lambda x: x, preconditioner)
-    free_step, _ = optimum._lsqr(at.operator(), at.residual, mu, preconditioner)
-    step, _ = optimum._lsqr(at.operator(), at.residual, mu, preconditioner, held)
+    free_step, _ = lsqr_step(at.operator(), at.residual, mu, preconditioner)
+    step, _ = lsqr_step(at.operator(), at.residual, mu, preconditioner, held)
     moved_by = at.deviation_change(at.response(step)[1]) - d
     assert np.abs(moved_by[nodes]).max() < 1e-9 * np.abs(moved_by).max()
     assert np.abs((at.deviation_change(at.response(free_step)[1]) - d)[nodes]).max() > 1e-3 * (

@@ -53,29 +53,26 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from ..materials import Hyperelastic
 from ..options import split_settings, takes_options
 from ..solver.linear import quiet_blas, solver_family
 from ..solver.options import SolveOptions
 from .erection import erect
-from .erection_bound import AT_BOUND, HeldNodes, ShapeBound
+from .erection_bound import ShapeBound
 from .erection_model import Pattern, patterns_of
 from .erection_optimum_result import OptimisedPatterns, OptimumRecord, optimised_results
 from .erection_residuals import (
-    PatternLayout,
     ResidualModel,
     edge_strain,
     erected_rms,
-    matched,
-    moved,
     pattern_edges,
-    seam_edges,
     stiffness_preconditioner,
 )
 from .erection_trials import ACCEPTANCE_ACCURACY, TRIAL_TOLERANCE, predicted_positions
+from .optimum_steps import norm_squared, step_direction
 from .options import ErectionOptions
+from .pattern_seams import PatternLayout, matched, moved, seam_edges
 
 __all__ = ["OptimisedPatterns", "OptimumRecord", "optimise_for_erection", "optimised_results"]
 
@@ -98,18 +95,12 @@ MIN_STEP_STRAIN = 1e-4
 #: tolerance (of ``J``) ends the optimisation before its trial is erected: its actual gain
 #: would not pass the tolerance either (the gains of the last steps are 0.25–0.95).
 PROMISED_GAIN = 1.0
-#: With a shape bound: how many times a step is solved again with more nodes held at the
-#: bound (:func:`_direction`).
-HOLD_PASSES = 2
 #: A step the bound cuts to less than this fraction of itself neither ends the optimisation by
 #: its small gain nor by its model's small promise (the promise of the step before the cut is
 #: what counts): the nodes that cut it are at the bound at the next step, and held there. On the
 #: isotropic 1,568-triangle hypar, patterns solved to the solver's tolerance from starts 1e-8
 #: apart ended at J = 0.661 … 0.830 when a cut step's promise ended the optimisation.
 BOUND_CUT = 0.5
-#: LSQR's relative tolerance and iteration limit for each step's least-squares problem.
-LSQR_TOLERANCE = 1e-3
-LSQR_LIMIT = 15
 #: Deviations are measured against the start's, but at least against a force of this strain
 #: times the stiffness and a length of this fraction of the size; deviations below these are
 #: round-off, nothing is left to gain (the erections are solved to 1e-10 of the stiffness: an
@@ -222,7 +213,7 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
             if mu is None:
                 nodes = layout.num_variables // 2
                 coarse = min(1.0, DAMPING_NODES / nodes)
-                mu = INITIAL_DAMPING * coarse * _norm_squared(model.operator())
+                mu = INITIAL_DAMPING * coarse * norm_squared(model.operator())
                 preconditioner = stiffness_preconditioner(
                     patterns, material, thickness, solver.linear_solver
                 )
@@ -230,7 +221,7 @@ def _optimise(source, material, thickness, solver, options, tolerance, callback)
             def strain_of(v, at=current):
                 return edge_strain(at, v, edges, layout)
 
-            step, step_strain, lsqr_its = _direction(
+            step, step_strain, lsqr_its = step_direction(
                 model, mu, preconditioner, strain_of, held, radius
             )
         scale = min(1.0, radius / step_strain) if step_strain > 0 else 1.0
@@ -323,76 +314,6 @@ def _overlapping(patterns: list[Pattern]) -> str | None:
             where = overlap.describe(pattern.mesh)
             return f"{pattern.name}: the optimised pattern is not one-to-one: {where}"
     return None
-
-
-def _direction(model, mu, preconditioner, strain_of, held=None, radius=None):
-    """A Levenberg–Marquardt step (seams kept matched to first order), its largest edge strain
-    and LSQR's iterations. With a bound ``held``: the nodes at the bound that the step (cut to
-    the trust region ``radius``) would move outwards by its linearised prediction are held where
-    they are (:class:`HeldNodes`: the step solved again on the null space of their constraints),
-    at most :data:`HOLD_PASSES` times; the step then slides along the bound."""
-    project = model.projection() if len(model.seams) else (lambda v: v)
-    d = model.erected.normal_deviation
-    at_bound = np.abs(d) >= (1.0 - AT_BOUND) * held.bound if held is not None else None
-    nodes, constraints, total = np.zeros(0, dtype=int), None, 0
-    for attempt in range(HOLD_PASSES + 1):
-        step, iterations = _lsqr(model.operator(), model.residual, mu, preconditioner, constraints)
-        total += iterations
-        step = project(step)
-        strain = strain_of(step)
-        if held is None or not at_bound.any() or attempt == HOLD_PASSES:
-            break
-        scale = min(1.0, radius / strain) if strain > 0 else 1.0
-        change = model.deviation_change(model.response(scale * step)[1]) - d
-        outwards = np.flatnonzero(at_bound & (np.sign(d) * change > 0))
-        outwards = outwards[~np.isin(outwards, nodes)]
-        if not len(outwards):
-            break
-        nodes = np.concatenate([nodes, outwards])
-        constraints = HeldNodes(model.deviation_gradients(nodes), project, preconditioner)
-    return step, strain, total
-
-
-def _lsqr(op, residual, mu, preconditioner=None, constraints=None):
-    """The Levenberg–Marquardt step ``min |J Δ + r|² + μ |Δ|²`` (to LSQR's loose tolerance: the
-    step is inexact) and LSQR's iterations; with a right ``preconditioner`` ``P`` (symmetric),
-    ``Δ = P y`` and LSQR solves for ``y`` the same problem, ``min |J P y + r|² + μ |P y|²``;
-    with ``constraints`` (:class:`HeldNodes`), for ``y`` on their null space."""
-    tol = LSQR_TOLERANCE
-    if preconditioner is None and constraints is None:
-        out = spla.lsqr(op, -residual, damp=np.sqrt(mu), atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
-        return out[0], out[2]
-    rows, root = len(residual), np.sqrt(mu)
-
-    def metric(y):
-        y = y if constraints is None else constraints.project(y)
-        return y if preconditioner is None else preconditioner.matvec(y)
-
-    def matvec(y):
-        step = metric(y)
-        return np.concatenate([op.matvec(step), root * step])
-
-    def rmatvec(u):
-        v = op.rmatvec(u[:rows]) + root * u[rows:]
-        v = v if preconditioner is None else preconditioner.matvec(v)
-        return v if constraints is None else constraints.project(v)
-
-    augmented = spla.LinearOperator((rows + op.shape[1], op.shape[1]), matvec, rmatvec, dtype=float)
-    rhs = np.concatenate([-residual, np.zeros(op.shape[1])])
-    out = spla.lsqr(augmented, rhs, atol=tol, btol=tol, iter_lim=LSQR_LIMIT)
-    return metric(out[0]), out[2]
-
-
-def _norm_squared(op, iterations: int = 4) -> float:
-    """An estimate of ``|J|²`` (power iteration on ``JᵀJ``)."""
-    v = np.random.default_rng(0).normal(size=op.shape[1])
-    value = 0.0
-    for _ in range(iterations):
-        v /= np.linalg.norm(v)
-        w = op.rmatvec(op.matvec(v))
-        value = float(np.linalg.norm(w))
-        v = w
-    return value
 
 
 def _trial_erection(trial, material, thickness, solver, options, erected, model, dx):
