@@ -247,8 +247,9 @@ def test_the_time_bound_stops_the_search_and_lays_its_shortest_nest():
 
 
 def test_a_search_that_fails_says_why(tmp_path, monkeypatch):
-    """A search that reports its failure, or whose process ends without a nest, is an error
-    with the search's own last word, not a nest."""
+    """A search that reports its failure, or whose process ends without its result (with or
+    without nests reported on its way), is an error with the search's own last word, not a
+    nest."""
     pieces, areas = tapered_pieces(2)
     failing = tmp_path / "failing.py"
     failing.write_text(
@@ -261,7 +262,18 @@ def test_a_search_that_fails_says_why(tmp_path, monkeypatch):
     crashing = tmp_path / "crashing.py"
     crashing.write_text("import sys\nsys.stdin.read()\nraise SystemExit('no spyrrow here')\n")
     monkeypatch.setattr(nesting, "_WORKER", crashing)
-    with pytest.raises(NestError, match="ended without a nest: no spyrrow here"):
+    with pytest.raises(NestError, match="ended without its result: no spyrrow here"):
+        nest_pieces(pieces, 2.5, net_areas=areas, time_limit=5)
+    # a search that reported a nest on its way, then died before its end: no nest is laid
+    # from it (a nest is taken before the search's end only at the bound)
+    dying = tmp_path / "dying.py"
+    dying.write_text(
+        "import json, sys\nsys.stdin.read()\n"
+        'print(json.dumps({"kind": "feasible", "width": 9.0, "placed": [[0, 0.0, 0.0, 0.0], '
+        '[1, 0.0, 5.0, 0.0]]}), flush=True)\nraise SystemExit("killed")\n'
+    )
+    monkeypatch.setattr(nesting, "_WORKER", dying)
+    with pytest.raises(NestError, match="ended without its result: killed"):
         nest_pieces(pieces, 2.5, net_areas=areas, time_limit=5)
 
 

@@ -333,7 +333,8 @@ def _first_records(
             record = records.get(timeout=max(left, 0.0) if best is not None else None)
         except queue.Empty:  # the bound: the search has a nest, take its shortest
             break
-        if record is None:
+        if record is None:  # the search ended without its own result: it failed
+            best = None
             break
         if record["kind"] == "error":
             raise NestError(f"the nesting search failed: {record['message']}")
@@ -347,7 +348,8 @@ def _first_records(
         status = "" if ended is None else f" (exit status {ended()})"
         message = "".join(errors).strip().splitlines()
         raise NestError(
-            "the nesting search ended without a nest" + (f": {message[-1]}" if message else status)
+            "the nesting search ended without its result"
+            + (f": {message[-1]}" if message else status)
         )
     return best["placed"], elapsed, finished
 
