@@ -245,7 +245,9 @@ def _search(spec: dict, seconds: float) -> tuple[list, float, bool]:
         return _first_records(records, started, seconds, errors)
     try:
         process = subprocess.Popen(
-            [interpreter, str(_WORKER)],
+            # -P: this package's folder not first on the search's module path (its modules
+            # would hide the standard library's of the same name)
+            [interpreter, "-P", str(_WORKER)],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
