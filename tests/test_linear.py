@@ -486,3 +486,37 @@ def test_tutte_by_pardiso_lu_is_tutte_by_superlu(monkeypatch):
         results["scipy-superlu"].material_coordinates,
         atol=1e-9 * np.abs(by_superlu).max(),
     )
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO not installed")
+def test_a_pardiso_solve_with_perturbed_pivots_is_checked(monkeypatch):
+    """A KKT system (two strips' seam matching: a zero block, whose pivots PARDISO perturbs)
+    is solved to round-off and the solve accepted; a solve whose residual is far off (as the
+    seam matching's in millimetres was, 2.3, before its rows were scaled) is refused with its
+    residual instead of being handed to Newton's method."""
+    from vares.geometry.examples import hypar_strips
+    from vares.structures import find_seams, split_panels
+    from vares.structures.matching import CoupledProblem
+
+    fabric = vares.materials.fabric("pes-pvc-type-2").material()
+    mesh, ids = hypar_strips()
+    strips = split_panels(mesh, ids)[:2]
+    results = [vares.solve(p.mesh, fabric, warp_angle=10.0) for p in strips]
+    coupled = CoupledProblem.build(results, fabric, 1.0, find_seams(strips))
+    kkt = coupled.kkt([r.material_coordinates for r in results], np.zeros(coupled.num_constraints))
+    rhs = np.random.default_rng(0).normal(size=kkt.matrix.shape[0])
+    solver = get_solver("pardiso")
+    solver.factorize(kkt.matrix)
+    assert solver._solver.iparm[13] > 0  # perturbed pivots: the first solve is checked
+    x = solver.solve(rhs)
+    assert np.linalg.norm(kkt.matrix @ x - rhs) < 1e-9 * np.linalg.norm(rhs)
+    phase = pardiso.PardisoSolver._phase
+
+    def astray(self, number, vector):  # a solve gone wrong, as on the badly scaled system
+        out = phase(self, number, vector)
+        return out * (1.0 + np.arange(out.size) % 3) if number == 33 else out
+
+    monkeypatch.setattr(pardiso.PardisoSolver, "_phase", astray)
+    solver.factorize(kkt.matrix)
+    with pytest.raises(SingularMatrixError, match="perturbed pivots has a relative residual of"):
+        solver.solve(rhs)

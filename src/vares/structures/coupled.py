@@ -174,9 +174,19 @@ class CoupledProblem:
             worst = max(worst, float(np.abs(a - b).max()))
         return worst
 
+    def _segment_lengths(self, seam: Seam) -> np.ndarray:
+        """The 3D lengths of a seam's segments (on its first panel's surface)."""
+        points = self.problems[seam.first].mesh.points[seam.nodes_first]
+        return np.linalg.norm(np.diff(points, axis=0), axis=1)
+
     def kkt(self, coordinates: list[np.ndarray], multipliers: np.ndarray) -> KKT:
         """The coupled problem at ``coordinates`` (one ``(n, 2)`` per panel) and
-        ``multipliers``."""
+        ``multipliers``. A seam segment's constraint is the difference of its two sides'
+        squared lengths over twice its 3D length: about the difference of the lengths, so that
+        its row of the Jacobian is about a unit vector whatever the length unit, as the rotation
+        rows are (with the squared lengths alone, a pattern in millimetres had rows a thousand
+        times longer than in metres, and PARDISO solved the KKT system to a relative residual of
+        2: its seam matching did not converge)."""
         blocks, gradient, energy = [], np.zeros(self.num_free), 0.0
         for p, (problem, assembler) in enumerate(zip(self.problems, self.assemblers, strict=True)):
             evaluation = problem.evaluate(coordinates[p], order=2)
@@ -200,6 +210,7 @@ class CoupledProblem:
             k = seam.segments
             segment_rows = row + np.arange(k)
             lam = multipliers[segment_rows] if multipliers.size else np.zeros(k)
+            weight = 0.5 / self._segment_lengths(seam)  # c = (|Δ_P|² − |Δ_Q|²) / (2 ℓ_3D)
             squared = []
             for panel, nodes, sign in (
                 (seam.first, seam.nodes_first, 1.0),
@@ -214,10 +225,10 @@ class CoupledProblem:
                     segment_rows,
                     ends,
                     delta,
-                    sign,
+                    sign * weight,
                     lam,
                 )
-            constraint.append(squared[0] - squared[1])
+            constraint.append(weight * (squared[0] - squared[1]))
             row += k
         n, m = self.num_free, row
         jacobian = _csr(b_rows, b_cols, b_values, (m, n))
@@ -228,22 +239,24 @@ class CoupledProblem:
 
 
 def _constraint_terms(jacobian, hessian, segment_rows, ends, delta, sign, lam) -> None:
-    """Add one side of a seam's segments: ``c = ±|Δ|²`` has the gradient ``±2Δ`` at the end
-    node and ``∓2Δ`` at the start node, and ``λ ∇²c = ±2λ [[I, −I], [−I, I]]`` per axis."""
+    """Add one side of a seam's segments: ``c = ±w|Δ|²`` (``sign``: ``±w``, per segment) has
+    the gradient ``±2wΔ`` at the end node and ``∓2wΔ`` at the start node, and ``λ ∇²c =
+    ±2wλ [[I, −I], [−I, I]]`` per axis."""
     (b_rows, b_cols, b_values), (rows, cols, values) = jacobian, hessian
+    sign = np.broadcast_to(sign, len(delta))
     for end, direction in zip(ends, (-1.0, 1.0), strict=True):
         for axis in range(2):
             dof = end[:, axis]
             kept = dof >= 0
             b_rows.append(segment_rows[kept])
             b_cols.append(dof[kept])
-            b_values.append(2.0 * sign * direction * delta[kept, axis])
+            b_values.append(2.0 * sign[kept] * direction * delta[kept, axis])
     for (e1, s1), (e2, s2) in itertools.product(zip(ends, (-1.0, 1.0), strict=True), repeat=2):
         for axis in range(2):
             kept = (e1[:, axis] >= 0) & (e2[:, axis] >= 0)
             rows.append(e1[kept, axis])
             cols.append(e2[kept, axis])
-            values.append(2.0 * sign * s1 * s2 * lam[kept])
+            values.append(2.0 * sign[kept] * s1 * s2 * lam[kept])
 
 
 def _csr(rows, cols, values, shape) -> sp.csr_matrix:
