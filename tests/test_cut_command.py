@@ -53,6 +53,9 @@ def test_cut_command_writes_the_plan_the_patterns_and_the_nest(tmp_path, small_s
     assert set(nesting) == {"roll_width", "length", "yield"} and 0 < nesting["yield"] < 1
     details = json.loads((out / "structure.json").read_text())["cutting"]
     assert details["surface_area"] == pytest.approx(details["panels_area"], rel=1e-12)
+    made = details["nest"]  # how the nest was made: a search's seed and bound, or pairs
+    assert made["time_limit"] == (1.0 if made["method"] == "search" else 0.0)
+    assert made["seed"] == (0 if made["method"] == "search" else None)
     for line in details["seam_lines"]:
         assert abs(line["excess"]) < 0.01  # each seam within 1 % of its geodesic
     drawing = ezdxf.readfile(out / "nest.dxf")

@@ -216,6 +216,7 @@ def test_the_conic_tent_uses_four_fifths_of_the_roll(roll):
     assert result.converged and result.plan.interlock
     nest = result.nest
     assert nest.method == "pairs" and nest.yield_ > 0.8
+    assert nest.seed is None and nest.finished and "no search" in nest.how  # made, not searched
     assert sorted(p.index for p in nest.pieces) == list(range(len(result.plan.panels)))
     assert max(result.widths) <= result.usable_width
     assert result.panel_area == pytest.approx(mesh.area, rel=1e-12)

@@ -99,7 +99,7 @@ def cutting_details(outcome: JobOutcome) -> dict:
             "method": nest.method,
             "search_seconds": nest.search_time,
             "time_limit": nest.time_limit,
-            "seed": result.options.nest_seed,
+            "seed": nest.seed,
             "finished": nest.finished,
             "pieces": [
                 {

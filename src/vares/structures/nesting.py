@@ -84,7 +84,8 @@ class RollNest:
     """Pieces on one roll: their placements, the length of roll used (from x = 0 to the end of
     the last piece), the net area (the patterns inside their seam lines) and the yield, net area
     / (roll width × length); the search's bound and time and whether it ended by itself (module
-    docs), the ``method``: ``search`` or ``pairs`` (:mod:`.pair_nest`), and the search's seed."""
+    docs), the ``method``: ``search`` or ``pairs`` (:mod:`.pair_nest`), and the search's seed
+    (``None`` without a search)."""
 
     roll_width: float
     length: float
@@ -95,7 +96,7 @@ class RollNest:
     search_time: float = 0.0
     finished: bool = False
     method: str = "search"
-    seed: int = 0
+    seed: int | None = None
 
     @property
     def yield_(self) -> float:
@@ -242,7 +243,7 @@ def _search(spec: dict, seconds: float) -> tuple[list, float, bool]:
         from ._nest_search import run
 
         threading.Thread(target=_in_thread, args=(run, spec, records), daemon=True).start()
-        return _first_records(records, started, seconds, errors)
+        return _search_result(records, started, seconds, errors)
     try:
         process = subprocess.Popen(
             # -P: this package's folder not first on the search's module path (its modules
@@ -288,13 +289,15 @@ def _search(spec: dict, seconds: float) -> tuple[list, float, bool]:
             readers[1].join(5.0)
             return status
 
-        return _first_records(records, started, seconds, errors, ended)
+        return _search_result(records, started, seconds, errors, ended)
     finally:
         if process.poll() is None:
             process.kill()
         process.wait()
         for reader in readers:
             reader.join(1.0)
+        for stream in (process.stdin, process.stdout, process.stderr):
+            stream.close()
 
 
 def _interpreter() -> str | None:
@@ -318,7 +321,7 @@ def _in_thread(run, spec: dict, records: queue.Queue) -> None:
     records.put(None)
 
 
-def _first_records(
+def _search_result(
     records: queue.Queue,
     started: float,
     seconds: float,
